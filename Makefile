@@ -1,0 +1,37 @@
+# `make help` lists the targets. The virtual environment .venv/ is made on first use.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+
+.PHONY: help venv run test validate bench lint clean
+
+help:  ## list the targets
+	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+venv: $(STAMP)  ## make the virtual environment and install sim into it
+
+run: $(STAMP)  ## run the default scene
+	$(PY) -m sim.demo
+
+test: $(STAMP)  ## quick tests (long physics runs are marked slow)
+	$(PY) -m pytest -q
+
+validate: $(STAMP)  ## every test, slow physics runs included
+	$(PY) -m pytest -q -m ""
+
+bench: $(STAMP)  ## engine rate table (see benchmarks/engine_rate.py --help)
+	$(PY) benchmarks/engine_rate.py
+
+lint: $(STAMP)  ## ruff over the sources and tests
+	$(VENV)/bin/ruff check src tests benchmarks
+
+clean:  ## remove the environment, caches and generated outputs
+	rm -rf $(VENV) outputs .pytest_cache build src/*.egg-info
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +

@@ -1,0 +1,172 @@
+"""Collision rate of the event engine: a table (or JSON rows) over N and packing fraction.
+
+Elastic disks in a periodic unit box, started from a lattice (or random placement when
+dilute) and equilibrated for ``--warmup`` collisions per disk before timing; one thread.
+Columns: collisions_per_s and events_per_s (events include neighbour-shell exits),
+bytes_per_disk (engine arrays) and rss_bytes_per_disk (peak resident-set growth),
+compile_s (first compiled call in this process: compilation or cache load), and
+reference_ratio (this engine over the textbook reference engine, same N and φ, same process,
+N ≤ 10⁴). Extra rows compare effects: ξ < 1 with TC, and the crater bed with and without
+its projectile.
+
+    python benchmarks/engine_rate.py                       # the full table
+    python benchmarks/engine_rate.py --n 10000 --phi 0.5 --json
+"""
+
+import argparse
+import json
+import os
+import platform
+import resource
+import time
+
+import numpy as np
+
+from sim.engine import Boundary, Engine
+from sim.initial import fixed_speed, hexagonal_lattice, random_sequential
+from sim.reference import ReferenceEngine
+
+FIRST_CALL = {"seconds": None}
+
+
+def equal_disks(n, phi, seed=1):
+    radius = float(np.sqrt(phi / (n * np.pi)))
+    if phi <= 0.3:
+        position = random_sequential(np.full(n, radius), periodic=(True, True), seed=seed)
+    else:
+        position = hexagonal_lattice(n, radius, periodic=(True, True), seed=seed)
+    return position, fixed_speed(n, 1.0, seed=seed + 1), radius
+
+
+def engine_bytes(engine):
+    return sum(v.nbytes for v in vars(engine).values() if isinstance(v, np.ndarray))
+
+
+def peak_rss_bytes():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def timed_rate(engine, collisions):
+    c0, e0 = engine.collisions, engine.events
+    started = time.perf_counter()
+    engine.run(collisions=c0 + collisions)
+    seconds = time.perf_counter() - started
+    return (engine.collisions - c0) / seconds, (engine.events - e0) / seconds
+
+
+def first_call(engine):
+    if FIRST_CALL["seconds"] is None:
+        started = time.perf_counter()
+        engine.run(events=engine.events + 1)
+        FIRST_CALL["seconds"] = time.perf_counter() - started
+    return FIRST_CALL["seconds"]
+
+
+def reference_rate(position, velocity, radius, events):
+    reference = ReferenceEngine(position, velocity, radius, periodic=(True, True))
+    reference.run(10)
+    c0 = reference.collisions
+    started = time.perf_counter()
+    reference.run(events)
+    return (reference.collisions - c0) / (time.perf_counter() - started)
+
+
+def gas_row(n, phi, collisions, warmup, reference_events, **effects):
+    rss_before = peak_rss_bytes()
+    position, velocity, radius = equal_disks(n, phi)
+    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
+                    **effects)
+    compile_s = first_call(engine)
+    engine.run(collisions=engine.collisions + int(warmup * n))
+    coll_rate, event_rate = timed_rate(engine, collisions)
+    row = {"scene": "gas" if not effects else "gas " + " ".join(
+               f"{k}={v}" for k, v in effects.items()),
+           "n": n, "phi": phi, "collisions_per_s": round(coll_rate),
+           "events_per_s": round(event_rate),
+           "bytes_per_disk": round(engine_bytes(engine) / n, 1),
+           "rss_bytes_per_disk": round(max(peak_rss_bytes() - rss_before, 0) / n, 1),
+           "compile_s": round(compile_s, 2), "reference_ratio": None}
+    if n <= 10_000 and not effects and reference_events:
+        # the reference needs O(N) per event: time it on the equilibrated state
+        row["reference_ratio"] = round(coll_rate / reference_rate(
+            engine.positions(), engine.velocity, radius, reference_events), 1)
+    return row
+
+
+def crater_rows(collisions, seed=1):
+    """The seed study's crater: 4000 bed disks (R = 0.0045) in the lower half, a projectile
+    of radius 0.05 at (0.5, 0.75) falling at 10, ξ = 0.5, TC 1e-8; against the same bed
+    with thermal motion and no projectile."""
+    n_bed, r_bed = 4000, 0.0045
+    bed = random_sequential(np.full(n_bed, r_bed), region=((0, 1), (0, 0.5)), seed=seed)
+    rows = []
+    for with_projectile in (False, True):
+        if with_projectile:
+            position = np.vstack([bed, [[0.5, 0.75]]])
+            velocity = np.vstack([np.zeros((n_bed, 2)), [[0.0, -10.0]]])
+            radius = np.append(np.full(n_bed, r_bed), 0.05)
+            mass = np.append(np.ones(n_bed), (0.05 / r_bed) ** 2)
+        else:
+            position, radius, mass = bed, r_bed, 1.0
+            velocity = fixed_speed(n_bed, 1.0, seed=seed + 1)
+        engine = Engine(position, velocity, radius, mass, restitution=0.5, tc=1e-8)
+        first_call(engine)
+        started = time.perf_counter()
+        engine.run(collisions=collisions, energy_fraction=0.1)
+        seconds = time.perf_counter() - started
+        rows.append({"scene": "crater" if with_projectile else "crater bed, no projectile",
+                     "n": engine.n, "phi": round(engine.packing_fraction, 3),
+                     "collisions_per_s": round(engine.collisions / seconds),
+                     "events_per_s": round(engine.events / seconds),
+                     "bytes_per_disk": round(engine_bytes(engine) / engine.n, 1),
+                     "rss_bytes_per_disk": None, "compile_s": None, "reference_ratio": None})
+    return rows
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, nargs="+", default=[1000, 10_000, 100_000, 1_000_000])
+    parser.add_argument("--phi", type=float, nargs="+", default=[0.1, 0.5, 0.7])
+    parser.add_argument("--collisions", type=int, default=3_000_000,
+                        help="timed collisions per row (at least 20 per disk)")
+    parser.add_argument("--warmup", type=float, default=10.0, help="collisions per disk")
+    parser.add_argument("--reference-events", type=int, default=300)
+    parser.add_argument("--no-effects", action="store_true", help="skip the effect rows")
+    parser.add_argument("--json", action="store_true", help="one JSON object per row")
+    args = parser.parse_args(argv)
+
+    rows = []
+    for n in sorted(args.n):
+        for phi in args.phi:
+            rows.append(gas_row(n, phi, max(args.collisions, 20 * n), args.warmup,
+                                args.reference_events))
+            emit(rows[-1], args.json, header=len(rows) == 1)
+    if not args.no_effects:
+        n = 10_000
+        rows.append(gas_row(n, 0.5, max(args.collisions, 20 * n), args.warmup, 0,
+                            restitution=0.9, tc=1e-6))
+        emit(rows[-1], args.json)
+        for row in crater_rows(min(args.collisions, 2_000_000)):
+            rows.append(row)
+            emit(row, args.json)
+    if not args.json:
+        print(f"\nmachine: {platform.processor() or platform.machine()}, "
+              f"{os.cpu_count()} cores, Python {platform.python_version()}, one thread")
+
+
+COLUMNS = ["scene", "n", "phi", "collisions_per_s", "events_per_s", "bytes_per_disk",
+           "rss_bytes_per_disk", "compile_s", "reference_ratio"]
+
+
+def emit(row, as_json, header=False):
+    if as_json:
+        print(json.dumps(row), flush=True)
+        return
+    if header:
+        print(" | ".join(COLUMNS))
+        print(" | ".join("---" for _ in COLUMNS))
+    print(" | ".join("" if row[c] is None else str(row[c]) for c in COLUMNS), flush=True)
+
+
+if __name__ == "__main__":
+    main()

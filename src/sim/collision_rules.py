@@ -1,0 +1,57 @@
+"""What happens at contact: smooth hard disks with normal restitution.
+
+Disk–disk (Brilliantov & Pöschel, *Kinetic Theory of Granular Gases*, §1; physics.md):
+with unit normal n = r_ij/|r_ij|, normal relative speed v_n = (v_i - v_j)·n < 0 and reduced mass
+μ = m_i m_j/(m_i + m_j), the impulse on i is Δp_i = -(1 + ξ) μ v_n n = -Δp_j. Momentum is
+conserved and the kinetic energy falls by exactly (1 - ξ²) μ v_n²/2. The collision virial
+r_ij·Δp_i = -(1 + ξ) μ v_n |r_ij| enters the pressure.
+
+Wall: v_n' = -ξ_w v_n, v_t' = v_t; the energy lost is (1 - ξ_w²) m v_n²/2.
+
+TC model (Luding & McNamara, Granular Matter 1, 113 (1998)): a contact is elastic when either
+partner touched anything — disk or wall — less than ``t_c`` ago. Wall contacts count, so a
+disk trapped between a wall and its neighbours cannot collapse against the wall either.
+
+Each function returns ``(dissipated energy, virial term)`` and updates velocities in place:
+``velocity: float64[n, 2]``, ``mass: float64[n]``.
+"""
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def collide_disks(i, j, rx, ry, xi, velocity, mass):
+    """Apply the impulse of a contact between disks i and j at separation r = r_i - r_j.
+
+    Returns (energy dissipated, r·Δp_i). Disks found separating (v_n ≥ 0, possible only by
+    round-off) are left alone.
+    """
+    r = math.sqrt(rx * rx + ry * ry)
+    nx = rx / r
+    ny = ry / r
+    v_n = (velocity[i, 0] - velocity[j, 0]) * nx + (velocity[i, 1] - velocity[j, 1]) * ny
+    if v_n >= 0.0:
+        return 0.0, 0.0
+    m_i = mass[i]
+    m_j = mass[j]
+    mu = m_i * m_j / (m_i + m_j)
+    impulse = (1.0 + xi) * mu * v_n
+    velocity[i, 0] -= impulse / m_i * nx
+    velocity[i, 1] -= impulse / m_i * ny
+    velocity[j, 0] += impulse / m_j * nx
+    velocity[j, 1] += impulse / m_j * ny
+    return 0.5 * (1.0 - xi * xi) * mu * v_n * v_n, -impulse * r
+
+
+@njit(cache=True, inline="always")
+def reflect_from_wall(i, axis, xi_wall, velocity, mass):
+    """Reverse the normal velocity of disk i at a wall normal to ``axis``.
+
+    Returns (energy dissipated, momentum given to the wall along the axis).
+    """
+    v_n = velocity[i, axis]
+    velocity[i, axis] = -xi_wall * v_n
+    m = mass[i]
+    return 0.5 * (1.0 - xi_wall * xi_wall) * m * v_n * v_n, m * (1.0 + xi_wall) * v_n

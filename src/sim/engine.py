@@ -1,0 +1,364 @@
+"""The engine as Python sees it: a state of arrays, and ``run`` with stop conditions.
+
+Python builds the state, calls the compiled loop (:func:`sim.event_loop.run_events`) in chunks
+of events, checks the conditions that need Python (wall-clock budget, user predicates) between
+chunks, and turns the loop's error codes into exceptions. No Python runs per event.
+
+State (n disks, s species), all owned by :class:`Engine`:
+  position, velocity float64[n, 2] — at each disk's own time ``t_disk`` float64[n];
+  radius, mass float64[n]; species int32[n];
+  collisions_per_disk int64[n] — disk and wall contacts of each disk;
+  plus the event, neighbour-shell and cell arrays documented in the modules that use them.
+"""
+
+import math
+import time as wallclock
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim import event_loop as loop
+from sim.event_queue import build_heap, empty_queue
+from sim.neighbours import build_all_neighbours, grow_lists
+
+#: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
+#: φ = 0.5 and about 4.6 at φ = 0.1); interpolated linearly between the points.
+SHELL_TABLE = ((0.0, 6.0), (0.1, 4.6), (0.3, 2.6), (0.5, 2.0), (0.7, 1.6), (0.91, 1.3))
+
+#: A disk is "big" (kept out of the cell grid) when its radius exceeds this multiple of the
+#: median radius, provided at most MAX_BIG disks are that large.
+BIG_RADIUS_RATIO = 2.0
+MAX_BIG = 64
+
+
+class StalledError(RuntimeError):
+    """Events keep arriving without the clock advancing: a numerical breakdown."""
+
+
+class InelasticCollapseError(RuntimeError):
+    """Inelastic collapse: a few disks collide infinitely often in finite time."""
+
+    def __init__(self, disks, time, collisions):
+        self.disks = disks
+        self.time = time
+        shown = ", ".join(str(d) for d in disks[:10]) + (" …" if len(disks) > 10 else "")
+        super().__init__(
+            f"inelastic collapse at t = {time:.17g} after {collisions} disk collisions: disks "
+            f"[{shown}] collide ever faster (consecutive contacts less than the collapse "
+            f"interval apart). Hard disks with restitution < 1 can collide infinitely often in "
+            f"finite time; switch on the TC model (tc.time, far below the mean free time; the "
+            f"seed study used 1e-8) so that contacts closer than t_c are elastic."
+        )
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """Box [0, Lx] × [0, Ly]; each axis has hard walls or is periodic."""
+
+    size: tuple = (1.0, 1.0)
+    periodic: tuple = (False, False)
+
+
+def shell_ratio(packing_fraction):
+    """Default neighbour-shell diameter r_n in units of the contact distance σ."""
+    phis, ratios = zip(*SHELL_TABLE, strict=True)
+    return float(np.interp(packing_fraction, phis, ratios))
+
+
+def _restitution_matrix(restitution, n_species):
+    """None for elastic contacts (the effect is dropped), else float64[s, s]."""
+    if restitution is None:
+        return None
+    xi = np.broadcast_to(np.asarray(restitution, dtype=np.float64), (n_species, n_species))
+    if not np.array_equal(xi, xi.T):
+        raise ValueError(f"restitution matrix must be symmetric, got {xi.tolist()}")
+    if np.any(xi < 0.0) or np.any(xi > 1.0):
+        raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
+    if np.all(xi == 1.0):
+        return None
+    return np.ascontiguousarray(xi)
+
+
+class Engine:
+    """Event-driven hard disks in a rectangular box.
+
+    Parameters
+    ----------
+    position, velocity : array (n, 2)
+    radius, mass : array (n,) or scalar
+    species : int array (n,), default all 0
+    boundary : :class:`Boundary`
+    restitution : scalar or (s, s) normal restitution ξ per species pair; 1 = elastic
+    wall_restitution : ξ_w for every wall; 1 = elastic
+    tc : TC-model time t_c (None or 0 = off)
+    shell : neighbour-shell diameter r_n/σ (default from the packing fraction)
+    collapse_interval, collapse_streak : inelastic-collapse detector: more than
+        ``collapse_streak`` consecutive dissipative contacts of one disk, each within
+        ``collapse_interval`` of the previous one. The default interval is 1e-6 of the time
+        a disk at the initial rms speed takes to cross its own diameter; in a gas, even a
+        dense one, a run of ten such intervals is far too unlikely ever to be seen, while a
+        collapsing cluster shrinks its intervals geometrically through that scale
+    """
+
+    def __init__(self, position, velocity, radius, mass=1.0, species=None,
+                 boundary=Boundary(), restitution=None, wall_restitution=None, tc=None,
+                 shell=None, collapse_interval=None, collapse_streak=10):
+        position = np.array(position, dtype=np.float64, order="C")
+        velocity = np.array(velocity, dtype=np.float64, order="C")
+        n = position.shape[0]
+        if position.shape != (n, 2) or velocity.shape != (n, 2) or n == 0:
+            raise ValueError(f"position and velocity must both be (n, 2) with n ≥ 1; got "
+                             f"{position.shape} and {velocity.shape}")
+        radius = np.array(np.broadcast_to(np.asarray(radius, np.float64), (n,)))
+        mass = np.array(np.broadcast_to(np.asarray(mass, np.float64), (n,)))
+        species = (np.zeros(n, np.int32) if species is None
+                   else np.array(np.broadcast_to(np.asarray(species), (n,)), dtype=np.int32))
+        if np.any(radius <= 0) or not np.all(np.isfinite(radius)):
+            raise ValueError("radius must be positive and finite")
+        if np.any(mass <= 0) or not np.all(np.isfinite(mass)):
+            raise ValueError("mass must be positive and finite")
+        if np.any(species < 0):
+            raise ValueError("species must be non-negative integers")
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
+            raise ValueError("positions and velocities must be finite")
+        box = np.array(boundary.size, dtype=np.float64)
+        periodic = np.array(boundary.periodic, dtype=bool)
+        self.boundary = boundary
+        self.n = n
+        self.n_species = int(species.max()) + 1
+        self.box = box
+        self.periodic = periodic
+        position = np.where(periodic, position % box, position)
+        for axis in range(2):
+            if not periodic[axis]:
+                low = position[:, axis] - radius
+                high = position[:, axis] + radius
+                if np.any(low < 0.0) or np.any(high > box[axis]):
+                    bad = int(np.flatnonzero((low < 0.0) | (high > box[axis]))[0])
+                    raise ValueError(f"disk {bad} at {position[bad].tolist()} with radius "
+                                     f"{radius[bad]} pokes through a wall of the box "
+                                     f"{box.tolist()}")
+
+        self.restitution = _restitution_matrix(restitution, self.n_species)
+        if wall_restitution is not None and not 0.0 <= wall_restitution <= 1.0:
+            raise ValueError(f"wall_restitution must lie in [0, 1], got {wall_restitution}")
+        self.wall_restitution = (None if wall_restitution is None or wall_restitution == 1.0
+                                 else float(wall_restitution))
+        if tc is not None and tc < 0:
+            raise ValueError(f"tc must be ≥ 0 or None, got {tc}")
+        dissipative = self.restitution is not None or self.wall_restitution is not None
+        self.tc = float(tc) if (tc and dissipative) else None
+
+        self.position = position
+        self.velocity = velocity
+        self.radius = radius
+        self.mass = mass
+        self.species = species
+        self.t_disk = np.zeros(n)
+        self.collisions_per_disk = np.zeros(n, dtype=np.int64)
+        self.t_last = np.full(n, -np.inf)
+        self.streak = np.zeros(n, dtype=np.int32)
+        self.counters = np.zeros(loop.N_COUNTERS, dtype=np.int64)
+        self.accumulators = np.zeros(loop.N_ACCUMULATORS)
+        self.pair_collisions = np.zeros((self.n_species, self.n_species), dtype=np.int64)
+        self.wall_impulse = np.zeros(4)
+        self.initial_energy = float(self.kinetic_energy())
+        self.rebase_every = 16 * n + 1024
+
+        self._setup_shells(shell)
+        v_rms = math.sqrt(2.0 * self.initial_energy / mass.sum()) if self.initial_energy else 1.0
+        crossing_time = 2.0 * float(np.median(radius)) / v_rms
+        self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
+                                  else float(collapse_interval))
+        self.collapse_streak = int(collapse_streak)
+        self._build()
+
+    # -- construction ---------------------------------------------------------------------
+    def _setup_shells(self, shell):
+        n, radius, box = self.n, self.radius, self.box
+        median = float(np.median(radius))
+        big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
+        if big.size > MAX_BIG:
+            big = big[:0]
+        is_big = np.zeros(n, dtype=bool)
+        is_big[big] = True
+        small_radius = radius[~is_big]
+        phi = float(np.pi * np.sum(radius**2) / np.prod(box))
+        phi_small = float(np.pi * np.sum(small_radius**2) / np.prod(box))
+        ratio = shell_ratio(phi) if shell is None else float(shell)
+        if ratio <= 1.0:
+            raise ValueError(f"shell (r_n/σ) must exceed 1, got {ratio}")
+        delta_small = 0.5 * (ratio - 1.0) * 2.0 * median
+        max_small = float(small_radius.max())
+        for axis in range(2):
+            if self.periodic[axis]:
+                # shells must not see two images of one disk: 2 (R + δ) ≤ L/2
+                limit = 0.25 * box[axis] - max_small
+                if limit <= 0.0:
+                    raise ValueError(f"periodic box side {box[axis]} is too small for disks of "
+                                     f"radius {max_small}: it must exceed 4 R")
+                delta_small = min(delta_small, limit)
+        delta = np.full(n, delta_small)
+        self.delta = delta
+        self.is_big = is_big
+        self.big = big.astype(np.int32)
+        reach = max_small + delta_small
+        cells = np.maximum(1, np.floor(box / (2.0 * reach)).astype(np.int64))
+        self.geometry = np.array([box[0], box[1], box[0] / cells[0], box[1] / cells[1], reach])
+        self.grid = np.array([cells[0], cells[1], int(self.periodic[0]), int(self.periodic[1])],
+                             dtype=np.int64)
+        # list capacity: twice the expected number of overlapping shells, plus a margin
+        expected = 4.0 * max(phi_small, 0.3) * (1.0 + delta_small / median) ** 2
+        cap = np.full(n, int(4 * math.ceil((2.0 * expected + 8.0) / 4)), dtype=np.int32)
+        if big.size:
+            density = max(phi_small, 0.6) / (np.pi * median**2)
+            reach_big = radius[big] + delta[big] + reach
+            cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
+        self.nb_cap = cap
+        self.nb_start = np.zeros(n, dtype=np.int64)
+        self.nb_start[1:] = np.cumsum(cap[:-1], dtype=np.int64)
+        self.nb = np.full(int(cap.sum()), -1, dtype=np.int32)
+        self.nb_count = np.zeros(n, dtype=np.int32)
+        self.center = np.zeros((n, 2))
+        self.cell_head = np.full(int(cells[0] * cells[1]), -1, dtype=np.int32)
+        self.cell_next = np.full(n, -1, dtype=np.int32)
+        self.cell_prev = np.full(n, -1, dtype=np.int32)
+        self.cell_of = np.full(n, -1, dtype=np.int32)
+        self.packing_fraction = phi
+
+    def _build(self):
+        while True:
+            full = build_all_neighbours(self.position, self.center, self.delta, self.radius,
+                                        self.is_big, self.nb_start, self.nb_cap, self.nb_count,
+                                        self.nb, self.cell_head, self.cell_next,
+                                        self.cell_prev, self.cell_of, self.big, self.geometry,
+                                        self.grid)
+            if full < 0:
+                break
+            self._grow_lists(full)
+        self.event_time = np.empty(self.n)
+        self.event_partner = np.empty(self.n, dtype=np.int32)
+        self.event_count = np.zeros(self.n, dtype=np.int64)
+        loop.predict_all(0.0, self.position, self.velocity, self.t_disk, self.center,
+                         self.delta, self.radius, self.collisions_per_disk, self.event_time,
+                         self.event_partner, self.event_count, self.nb_start, self.nb_count,
+                         self.nb, self.geometry, self.grid)
+        self.heap, self.slot = empty_queue(self.n)
+        build_heap(self.heap, self.slot, self.event_time)
+
+    def _grow_lists(self, full):
+        disks = np.union1d([full], np.flatnonzero(self.nb_count >= self.nb_cap))
+        self.nb_start, self.nb_cap, self.nb_count, self.nb = grow_lists(
+            self.nb_start, self.nb_cap, self.nb_count, self.nb, disks)
+
+    # -- running --------------------------------------------------------------------------
+    def _run_chunk(self, max_events, max_collisions, t_stop, dissipation_limit):
+        while True:
+            status, disk = loop.run_events(
+                self.position, self.velocity, self.t_disk, self.center, self.delta,
+                self.radius, self.mass, self.species, self.collisions_per_disk, self.t_last,
+                self.streak, self.event_time, self.event_partner, self.event_count, self.heap,
+                self.slot, self.nb_start, self.nb_cap, self.nb_count, self.nb, self.cell_head,
+                self.cell_next, self.cell_prev, self.cell_of, self.big, self.geometry,
+                self.grid, self.restitution, self.wall_restitution, self.tc, self.counters,
+                self.accumulators, self.pair_collisions, self.wall_impulse,
+                max_events, max_collisions, t_stop, dissipation_limit,
+                self.collapse_interval, self.collapse_streak, self.rebase_every)
+            if status == loop.STATUS_LIST_FULL:
+                self._grow_lists(disk)
+                continue
+            if status == loop.STATUS_STALLED:
+                raise StalledError(
+                    f"the clock is stuck at t = {self.time:.17g}: more than 16 N + 1000 events "
+                    f"in a row at one instant, last for disk {disk} at position "
+                    f"{self.position[disk].tolist()} with velocity "
+                    f"{self.velocity[disk].tolist()}; the state is beyond float64 resolution "
+                    f"(for inelastic disks, switch on the TC model)")
+            if status == loop.STATUS_COLLAPSE:
+                cluster = np.flatnonzero(self.streak >= 2)
+                raise InelasticCollapseError(sorted(set(cluster.tolist()) | {int(disk)}),
+                                             self.time, self.collisions)
+            return status
+
+    def run(self, *, events=None, collisions=None, time=None, energy_fraction=None,
+            wall_seconds=None, until=None, chunk_events=200_000):
+        """Advance until the first stop condition holds; returns its name.
+
+        events, collisions : totals since the start of the engine (applied events include
+            disk and wall contacts and neighbour-shell exits)
+        time : absolute simulated time; the run stops at the last event not after it
+        energy_fraction : stop once the kinetic energy is this fraction of the initial one
+        wall_seconds : wall-clock budget of this call, checked between chunks
+        until : predicate ``until(engine) -> bool`` checked between chunks
+        chunk_events : events per compiled call
+        """
+        if all(x is None for x in (events, collisions, time, energy_fraction, wall_seconds,
+                                   until)):
+            raise ValueError("run() needs at least one stop condition")
+        big = np.iinfo(np.int64).max
+        max_events = big if events is None else int(events)
+        max_collisions = big if collisions is None else int(collisions)
+        t_stop = math.inf if time is None else float(time)
+        dissipation_limit = (math.inf if energy_fraction is None
+                             else self.initial_energy * (1.0 - float(energy_fraction)))
+        started = wallclock.perf_counter()
+        reasons = {loop.STATUS_COLLISION_LIMIT: "collisions", loop.STATUS_TIME_REACHED: "time",
+                   loop.STATUS_ENERGY_REACHED: "energy_fraction",
+                   loop.STATUS_NO_EVENTS: "no_events"}
+        while True:
+            chunk_end = min(max_events, int(self.counters[loop.EVENTS]) + int(chunk_events))
+            status = self._run_chunk(chunk_end, max_collisions, t_stop, dissipation_limit)
+            if status == loop.STATUS_EVENT_LIMIT:
+                if self.counters[loop.EVENTS] >= max_events:
+                    return "events"
+            else:
+                return reasons[status]
+            if wall_seconds is not None and wallclock.perf_counter() - started >= wall_seconds:
+                return "wall_seconds"
+            if until is not None and until(self):
+                return "predicate"
+
+    # -- observables ----------------------------------------------------------------------
+    @property
+    def time(self):
+        """Absolute time of the last processed event."""
+        return float(self.accumulators[loop.T_ORIGIN] + self.accumulators[loop.T_NOW])
+
+    @property
+    def collisions(self):
+        return int(self.counters[loop.DISK_COLLISIONS])
+
+    @property
+    def wall_collisions(self):
+        return int(self.counters[loop.WALL_COLLISIONS])
+
+    @property
+    def events(self):
+        return int(self.counters[loop.EVENTS])
+
+    @property
+    def dissipated_energy(self):
+        return float(self.accumulators[loop.DISSIPATED_DISKS]
+                     + self.accumulators[loop.DISSIPATED_WALLS])
+
+    @property
+    def virial(self):
+        """Σ r_ij·Δp_i over all disk–disk contacts so far."""
+        return float(self.accumulators[loop.VIRIAL])
+
+    def positions(self, t=None):
+        """Positions of every disk at absolute time ``t`` (default: the current time)."""
+        t_rel = (self.accumulators[loop.T_NOW] if t is None
+                 else float(t) - self.accumulators[loop.T_ORIGIN])
+        return loop.positions_at(t_rel, self.position, self.velocity, self.t_disk,
+                                 self.geometry, self.grid)
+
+    def kinetic_energy_by_species(self):
+        return loop.kinetic_energy_by_species(self.velocity, self.mass, self.species,
+                                              self.n_species)
+
+    def kinetic_energy(self):
+        return float(np.sum(0.5 * self.mass * np.sum(self.velocity**2, axis=1)))
+
+    def momentum(self):
+        return (self.mass[:, None] * self.velocity).sum(axis=0)

@@ -1,0 +1,199 @@
+"""Event engine: exact paths, conservation laws, bookkeeping, stop conditions, determinism."""
+
+import math
+
+import numpy as np
+import pytest
+
+from conftest import assert_no_overlap, gas
+from sim.audit import overlapping_pairs
+from sim.engine import Boundary, Engine, InelasticCollapseError
+from sim.initial import PlacementError, hexagonal_lattice, random_sequential
+
+
+def triangle_wave(s, low, high):
+    """Position of a point bouncing between low and high after travelling s from low."""
+    span = high - low
+    phase = np.mod(s, 2.0 * span)
+    return low + np.where(phase < span, phase, 2.0 * span - phase)
+
+
+def test_single_disk_traces_tilted_rectangle_for_10000_wall_events():
+    """Launched at 45° from the middle of the left wall, the disk visits the middles of the
+    four walls in turn: x and y are triangle waves of the distance travelled."""
+    radius = 0.05
+    v = np.array([1.0, 1.0]) / math.sqrt(2.0)
+    engine = Engine([[radius, 0.5]], [v], radius)
+    energy = engine.kinetic_energy()
+    side = 1.0 - 2.0 * radius
+    for t in np.linspace(0.0, 5_000 * side / v[0], 101)[1:]:
+        engine.run(time=t)
+        expected = [triangle_wave(v[0] * t, radius, 1 - radius),
+                    triangle_wave(0.5 - radius + v[1] * t, radius, 1 - radius)]
+        np.testing.assert_allclose(engine.positions(t)[0], expected, rtol=0, atol=1e-9)
+    assert engine.wall_collisions == pytest.approx(10_000, abs=1)
+    assert engine.kinetic_energy() == energy
+
+
+@pytest.mark.parametrize("periodic", [(False, False), (True, True)])
+def test_elastic_energy_drift_over_a_million_collisions(periodic):
+    engine = gas(10_000, 0.5, periodic, seed=3)
+    energy = engine.kinetic_energy()
+    engine.run(collisions=1_000_000)
+    assert abs(engine.kinetic_energy() / energy - 1.0) <= 1e-12
+    assert_no_overlap(engine)
+
+
+@pytest.mark.parametrize("phi", [0.3, 0.72, 0.85])
+@pytest.mark.parametrize("periodic", [(False, False), (True, False), (True, True)])
+def test_no_overlap_and_no_escape(phi, periodic):
+    engine = gas(2000, phi, periodic, seed=5)
+    for _ in range(5):
+        engine.run(collisions=engine.collisions + 40_000)
+        assert_no_overlap(engine)
+
+
+def test_momentum_conserved_in_periodic_box():
+    engine = gas(1000, 0.4, (True, True), seed=7, restitution=0.8, tc=1e-6)
+    p0 = engine.momentum()
+    engine.run(collisions=100_000)
+    assert engine.momentum() == pytest.approx(p0, abs=1e-12 * engine.n)
+    assert_no_overlap(engine)
+
+
+def test_dissipation_bookkeeping_is_exact():
+    """E0 − E = Σ (1 − ξ²) μ v_n²/2 over disk contacts + Σ (1 − ξ_w²) m v_n²/2 over walls."""
+    engine = gas(1000, 0.3, seed=11, restitution=0.8, wall_restitution=0.9, tc=1e-7)
+    e0 = engine.kinetic_energy()
+    engine.run(collisions=50_000)
+    lost = e0 - engine.kinetic_energy()
+    assert lost > 0.5 * e0
+    assert engine.dissipated_energy == pytest.approx(lost, rel=1e-12)
+    assert_no_overlap(engine)
+
+
+def test_energy_fraction_stop_is_at_the_crossing_collision():
+    engine = gas(500, 0.3, seed=2, restitution=0.7, tc=1e-7)
+    e0 = engine.kinetic_energy()
+    assert engine.run(energy_fraction=0.1) == "energy_fraction"
+    assert engine.kinetic_energy() <= 0.1 * e0
+    # the collision before the last one had not yet crossed
+    last = engine.dissipated_energy
+    assert e0 - last <= 0.1 * e0 < e0 - last + 0.5 * e0
+
+
+def test_time_reversal_returns_to_the_start():
+    """Round-off grows with the Lyapunov exponent; in a dense fluid (φ = 0.6, mean free path
+    ≈ 0.1 σ) 1000 collisions of 100 disks there and back stay well inside 1e-8."""
+    engine = gas(100, 0.6, (True, True), seed=13)
+    start = engine.positions()
+    engine.run(collisions=1000)
+    t = engine.time
+    back = Engine(engine.positions(), -engine.velocity, engine.radius,
+                  boundary=engine.boundary)
+    back.run(time=t)
+    d = back.positions(t) - start
+    d -= np.round(d)
+    assert np.abs(d).max() < 1e-8
+    assert back.collisions == 1000
+
+
+def test_stop_exactly_at_requested_time_and_positions_there():
+    engine = gas(400, 0.3, seed=17)
+    assert engine.run(time=0.25) == "time"
+    assert engine.time <= 0.25
+    assert engine.event_time[engine.heap[0]] + engine.accumulators[0] > 0.25
+    at = engine.positions(0.25)
+    expected = engine.position + engine.velocity * (0.25 - engine.accumulators[0]
+                                                     - engine.t_disk[:, None])
+    assert at == pytest.approx(expected, abs=1e-14)
+
+
+def test_until_predicate_and_wall_clock_budget():
+    engine = gas(400, 0.3, seed=19)
+    reason = engine.run(until=lambda e: e.collisions >= 5000, chunk_events=1000)
+    assert reason == "predicate" and 5000 <= engine.collisions < 5000 + 1000
+    assert engine.run(wall_seconds=0.05, chunk_events=1000) == "wall_seconds"
+
+
+def test_same_inputs_same_bits_whatever_the_chunking():
+    a = gas(500, 0.5, (True, False), seed=23, restitution=0.9, tc=1e-6)
+    b = gas(500, 0.5, (True, False), seed=23, restitution=0.9, tc=1e-6)
+    a.run(collisions=30_000)
+    b.run(collisions=30_000, chunk_events=777)
+    np.testing.assert_array_equal(a.position, b.position)
+    np.testing.assert_array_equal(a.velocity, b.velocity)
+    assert a.time == b.time
+
+
+def test_rebased_clock_keeps_the_trajectory():
+    """Restarting the clock every few events does not change the physics beyond round-off."""
+    a = gas(300, 0.3, (True, True), seed=29)
+    b = gas(300, 0.3, (True, True), seed=29)
+    b.rebase_every = 100
+    a.run(collisions=500)
+    b.run(collisions=500)
+    assert b.time == pytest.approx(a.time, rel=1e-13)
+    assert b.accumulators[0] > 0.0  # b's clock was restarted
+    d = a.positions(a.time) - b.positions(a.time)
+    assert np.abs(d - np.round(d)).max() < 1e-9
+
+
+def test_inelastic_collapse_is_detected_and_tc_cures_it():
+    """Three disks in a row at ξ = 0.05 < 7 − 4√3 collapse (McNamara & Young 1992)."""
+    radius = 0.01
+    x = np.array([0.4, 0.5, 0.6])
+    position = np.stack([x, np.full(3, 0.5)], axis=1)
+    velocity = [[1.0, 0.0], [0.0, 0.0], [-0.7, 0.0]]
+    engine = Engine(position, velocity, radius, restitution=0.05)
+    with pytest.raises(InelasticCollapseError, match="TC model") as caught:
+        engine.run(collisions=1_000_000)
+    assert set(caught.value.disks) == {0, 1, 2}
+    cured = Engine(position, velocity, radius, restitution=0.05, tc=1e-6)
+    assert cured.run(collisions=100_000, time=10.0) in {"collisions", "time"}
+    assert_no_overlap(cured)
+
+
+def test_heavy_big_projectile_in_a_bed_of_small_disks():
+    bed_radius, n_bed = 0.0045, 3000
+    bed = random_sequential(np.full(n_bed, bed_radius), region=((0, 1), (0, 0.5)), seed=31)
+    r_p = 0.05
+    position = np.vstack([bed, [[0.5, 0.75]]])
+    velocity = np.vstack([np.zeros((n_bed, 2)), [[0.0, -10.0]]])
+    radius = np.append(np.full(n_bed, bed_radius), r_p)
+    mass = np.append(np.ones(n_bed), (r_p / bed_radius) ** 2)
+    engine = Engine(position, velocity, radius, mass, restitution=0.5, tc=1e-8)
+    assert engine.is_big.sum() == 1 and engine.is_big[-1]
+    e0 = engine.kinetic_energy()
+    engine.run(energy_fraction=0.1, collisions=3_000_000)
+    assert engine.kinetic_energy() == pytest.approx(e0 - engine.dissipated_energy, rel=1e-10)
+    assert engine.positions()[-1, 1] < 0.75
+    assert_no_overlap(engine)
+
+
+def test_random_placement_fails_clearly_beyond_its_reach():
+    with pytest.raises(PlacementError, match=r"0\.547.*lattice"):
+        random_sequential(np.full(1000, math.sqrt(0.7 / (1000 * math.pi))), seed=1)
+
+
+def test_lattice_reaches_dense_packings_without_overlap():
+    # 20 × 24 sites fit a periodic box of aspect 24 (√3/2) / 20 with perfect triangles
+    n, box, periodic = 480, (1.0, 24 * math.sqrt(3.0) / 2.0 / 20), (True, True)
+    radius = math.sqrt(0.9 * box[0] * box[1] / (n * math.pi))
+    position = hexagonal_lattice(n, radius, box=box, periodic=periodic, seed=1)
+    engine = Engine(position, np.zeros((n, 2)), radius,
+                    boundary=Boundary(size=box, periodic=periodic))
+    assert_no_overlap(engine)
+    radius = math.sqrt(0.85 / (1000 * math.pi))
+    for periodic in [(False, False), (True, True)]:
+        square = hexagonal_lattice(1000, radius, periodic=periodic)
+        assert overlapping_pairs(square, radius, periodic=periodic)[0].size == 0
+
+
+def test_bad_input_is_rejected():
+    with pytest.raises(ValueError, match="pokes through a wall"):
+        Engine([[0.0, 0.5]], [[1.0, 0.0]], 0.1)
+    with pytest.raises(ValueError, match="restitution"):
+        Engine([[0.5, 0.5]], [[1.0, 0.0]], 0.1, restitution=1.5)
+    with pytest.raises(ValueError, match="radius"):
+        Engine([[0.5, 0.5]], [[1.0, 0.0]], -0.1)
