@@ -126,6 +126,17 @@ def test_same_inputs_same_bits_whatever_the_chunking():
     assert a.time == b.time
 
 
+def test_full_neighbour_lists_grow_without_changing_the_physics():
+    roomy = gas(800, 0.6, (True, True), seed=37)
+    tight = gas(800, 0.6, (True, True), seed=37, list_capacity=1)
+    assert tight.nb_cap.max() > 1  # grown while the lists were first built
+    roomy.run(collisions=40_000)
+    tight.run(collisions=40_000)
+    assert tight.time == pytest.approx(roomy.time, rel=1e-12)
+    np.testing.assert_allclose(tight.velocity, roomy.velocity, rtol=0, atol=1e-9)
+    assert_no_overlap(tight)
+
+
 def test_rebased_clock_keeps_the_trajectory():
     """Restarting the clock every few events does not change the physics beyond round-off."""
     a = gas(300, 0.3, (True, True), seed=29)

@@ -92,6 +92,8 @@ class Engine:
     wall_restitution : ξ_w for every wall; 1 = elastic
     tc : TC-model time t_c (None or 0 = off)
     shell : neighbour-shell diameter r_n/σ (default from the packing fraction)
+    list_capacity : initial slots per neighbour list of an ordinary disk (default from the
+        expected number of neighbours); full lists grow on demand
     collapse_interval, collapse_streak : inelastic-collapse detector: more than
         ``collapse_streak`` consecutive dissipative contacts of one disk, each within
         ``collapse_interval`` of the previous one. The default interval is 1e-6 of the time
@@ -102,7 +104,7 @@ class Engine:
 
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
                  boundary=Boundary(), restitution=None, wall_restitution=None, tc=None,
-                 shell=None, collapse_interval=None, collapse_streak=10):
+                 shell=None, collapse_interval=None, collapse_streak=10, list_capacity=None):
         position = np.array(position, dtype=np.float64, order="C")
         velocity = np.array(velocity, dtype=np.float64, order="C")
         n = position.shape[0]
@@ -165,7 +167,7 @@ class Engine:
         self.initial_energy = float(self.kinetic_energy())
         self.rebase_every = 16 * n + 1024
 
-        self._setup_shells(shell)
+        self._setup_shells(shell, list_capacity)
         v_rms = math.sqrt(2.0 * self.initial_energy / mass.sum()) if self.initial_energy else 1.0
         crossing_time = 2.0 * float(np.median(radius)) / v_rms
         self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
@@ -174,7 +176,7 @@ class Engine:
         self._build()
 
     # -- construction ---------------------------------------------------------------------
-    def _setup_shells(self, shell):
+    def _setup_shells(self, shell, list_capacity):
         n, radius, box = self.n, self.radius, self.box
         median = float(np.median(radius))
         big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
@@ -209,7 +211,9 @@ class Engine:
                              dtype=np.int64)
         # list capacity: twice the expected number of overlapping shells, plus a margin
         expected = 4.0 * max(phi_small, 0.3) * (1.0 + delta_small / median) ** 2
-        cap = np.full(n, int(4 * math.ceil((2.0 * expected + 8.0) / 4)), dtype=np.int32)
+        if list_capacity is None:
+            list_capacity = int(4 * math.ceil((2.0 * expected + 8.0) / 4))
+        cap = np.full(n, max(int(list_capacity), 1), dtype=np.int32)
         if big.size:
             density = max(phi_small, 0.6) / (np.pi * median**2)
             reach_big = radius[big] + delta[big] + reach

@@ -28,13 +28,17 @@ class PlacementError(ValueError):
 def _rsa(radius, lo, hi, box, periodic, rng, max_attempts):
     n = radius.shape[0]
     position = np.zeros((n, 2))
+    # cells of at least one largest diameter; a periodic axis is cut into whole cells of
+    # [lo, hi) so that cell indices wrap, a walled one is padded by a radius on each side
     cell = 2.0 * radius.max()
-    ncx = max(1, int((hi[0] - lo[0] + 2 * radius.max()) / cell))
-    ncy = max(1, int((hi[1] - lo[1] + 2 * radius.max()) / cell))
-    wx = (hi[0] - lo[0] + 2 * radius.max()) / ncx
-    wy = (hi[1] - lo[1] + 2 * radius.max()) / ncy
-    ox = lo[0] - radius.max()
-    oy = lo[1] - radius.max()
+    pad_x = 0.0 if periodic[0] else radius.max()
+    pad_y = 0.0 if periodic[1] else radius.max()
+    ncx = max(1, int((hi[0] - lo[0] + 2 * pad_x) / cell))
+    ncy = max(1, int((hi[1] - lo[1] + 2 * pad_y) / cell))
+    wx = (hi[0] - lo[0] + 2 * pad_x) / ncx
+    wy = (hi[1] - lo[1] + 2 * pad_y) / ncy
+    ox = lo[0] - pad_x
+    oy = lo[1] - pad_y
     head = np.full(ncx * ncy, -1, np.int64)
     nxt = np.full(n, -1, np.int64)
     for i in range(n):

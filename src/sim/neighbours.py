@@ -200,17 +200,22 @@ def build_all_neighbours(position, center, delta, radius, is_big, nb_start, nb_c
     return -1
 
 
+@njit(cache=True)
+def _copy_lists(nb_start, nb_count, nb, new_start, new_nb):
+    for i in range(nb_start.shape[0]):
+        for k in range(nb_count[i]):
+            new_nb[new_start[i] + k] = nb[nb_start[i] + k]
+
+
 def grow_lists(nb_start, nb_cap, nb_count, nb, disks):
     """Return enlarged neighbour arrays: the lists of ``disks`` double their capacity.
 
-    Contents and counts are kept; a rare step, done in numpy between compiled calls.
+    Contents and counts are kept; a rare step, done between compiled calls.
     """
     new_cap = nb_cap.copy()
     new_cap[disks] *= 2
     new_start = np.zeros_like(nb_start)
     new_start[1:] = np.cumsum(new_cap[:-1], dtype=np.int64)
     new_nb = np.full(int(new_start[-1] + new_cap[-1]), -1, dtype=np.int32)
-    for i in range(nb_start.shape[0]):
-        k = nb_count[i]
-        new_nb[new_start[i]:new_start[i] + k] = nb[nb_start[i]:nb_start[i] + k]
+    _copy_lists(nb_start, nb_count, nb, new_start, new_nb)
     return new_start, new_cap, nb_count, new_nb

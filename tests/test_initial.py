@@ -1,0 +1,67 @@
+"""Initial states: placement without overlap, where asked, reproducibly; velocity laws."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from sim.audit import outside_box, overlapping_pairs
+from sim.initial import (
+    PlacementError,
+    fixed_speed,
+    hexagonal_lattice,
+    maxwellian,
+    random_sequential,
+    remove_drift,
+)
+
+
+@pytest.mark.parametrize("periodic", [(False, False), (True, True)])
+def test_random_placement_polydisperse_without_overlap(periodic):
+    rng = np.random.default_rng(0)
+    radius = rng.uniform(0.003, 0.009, 3000)
+    position = random_sequential(radius, periodic=periodic, seed=1)
+    assert overlapping_pairs(position, radius, periodic=periodic, tolerance=0.0)[0].size == 0
+    assert outside_box(position, radius, periodic=periodic, tolerance=0.0).size == 0
+    np.testing.assert_array_equal(position, random_sequential(radius, periodic=periodic, seed=1))
+    assert not np.array_equal(position, random_sequential(radius, periodic=periodic, seed=2))
+
+
+def test_random_placement_stays_in_its_region():
+    radius = np.full(2000, 0.0045)
+    position = random_sequential(radius, region=((0.0, 1.0), (0.0, 0.5)), seed=3)
+    assert position[:, 1].max() <= 0.5 - 0.0045
+    assert position[:, 1].min() >= 0.0045
+
+
+def test_random_placement_error_reports_the_packing_reached():
+    with pytest.raises(PlacementError, match=r"stopped at packing fraction 0\.[45]\d\d"):
+        random_sequential(np.full(2000, np.sqrt(0.6 / (2000 * np.pi))), seed=4)
+
+
+def test_lattice_in_a_region_with_jitter():
+    radius = 0.0045
+    position = hexagonal_lattice(4000, radius, region=((0.0, 1.0), (0.0, 0.5)), seed=5)
+    assert overlapping_pairs(position, radius, tolerance=0.0)[0].size == 0
+    assert position[:, 1].max() <= 0.5 - radius and position[:, 1].min() >= radius
+    assert np.unique(np.round(position[:, 1], 6)).size > 100  # jittered, not bare rows
+
+
+def test_lattice_error_names_the_limit():
+    with pytest.raises(PlacementError, match="0.9069"):
+        hexagonal_lattice(1000, np.sqrt(0.93 / (1000 * np.pi)))
+
+
+def test_fixed_speed_directions_are_uniform():
+    v = fixed_speed(20_000, 2.5, seed=6)
+    np.testing.assert_allclose(np.hypot(*v.T), 2.5, rtol=1e-15)
+    angle = np.arctan2(v[:, 1], v[:, 0])
+    assert stats.kstest(angle, stats.uniform(-np.pi, 2 * np.pi).cdf).pvalue > 1e-3
+
+
+def test_maxwellian_components_and_zero_drift():
+    mass = np.where(np.arange(20_000) % 2, 1.0, 4.0)
+    v = remove_drift(maxwellian(mass, 0.7, seed=7), mass)
+    assert np.abs((mass[:, None] * v).sum(axis=0)).max() < 1e-10
+    for m in (1.0, 4.0):
+        components = v[mass == m].ravel()
+        assert stats.kstest(components, stats.norm(scale=np.sqrt(0.7 / m)).cdf).pvalue > 1e-3
