@@ -39,7 +39,8 @@ def equal_disks(n, phi, seed=1):
 
 
 def engine_bytes(engine):
-    return sum(v.nbytes for v in vars(engine).values() if isinstance(v, np.ndarray))
+    return engine.disks.nbytes + sum(v.nbytes for v in vars(engine).values()
+                                     if isinstance(v, np.ndarray))
 
 
 def peak_rss_bytes():
@@ -89,7 +90,7 @@ def gas_row(n, phi, collisions, warmup, reference_events, **effects):
     if n <= 10_000 and not effects and reference_events:
         # the reference needs O(N) per event: time it on the equilibrated state
         row["reference_ratio"] = round(coll_rate / reference_rate(
-            engine.positions(), engine.velocity, radius, reference_events), 1)
+            engine.positions(), engine.velocities(), radius, reference_events), 1)
     return row
 
 

@@ -4,11 +4,11 @@ Python builds the state, calls the compiled loop (:func:`sim.event_loop.run_even
 of events, checks the conditions that need Python (wall-clock budget, user predicates) between
 chunks, and turns the loop's error codes into exceptions. No Python runs per event.
 
-State (n disks, s species), all owned by :class:`Engine`:
-  position, velocity float64[n, 2] — at each disk's own time ``t_disk`` float64[n];
-  radius, mass float64[n]; species int32[n];
-  collisions_per_disk int64[n] — disk and wall contacts of each disk;
-  plus the event, neighbour-shell and cell arrays documented in the modules that use them.
+The per-disk state lives in :class:`sim.state.DiskArrays`, in engine order: disks are
+renumbered by grid cell so that neighbours in space are neighbours in memory, and renumbered
+again every ``reorder_every`` events as they diffuse. Everything the user reads
+(:meth:`Engine.positions`, :meth:`Engine.velocities`, ``radius``, ``mass``, ``species``, …) is
+in the original order.
 """
 
 import math
@@ -20,10 +20,16 @@ import numpy as np
 from sim import event_loop as loop
 from sim.event_queue import build_heap, empty_queue
 from sim.neighbours import build_all_neighbours, grow_lists
+from sim.state import DiskArrays
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
 #: φ = 0.5 and about 4.6 at φ = 0.1); interpolated linearly between the points.
 SHELL_TABLE = ((0.0, 6.0), (0.1, 4.6), (0.3, 2.6), (0.5, 2.0), (0.7, 1.6), (0.91, 1.3))
+
+#: Disks are renumbered by cell every this many events per disk, from this many disks on
+#: (below it the whole state sits in cache and order does not matter).
+REORDER_EVENTS_PER_DISK = 50
+REORDER_MIN_DISKS = 20_000
 
 #: A disk is "big" (kept out of the cell grid) when its radius exceeds this multiple of the
 #: median radius, provided at most MAX_BIG disks are that large.
@@ -151,32 +157,28 @@ class Engine:
         dissipative = self.restitution is not None or self.wall_restitution is not None
         self.tc = float(tc) if (tc and dissipative) else None
 
-        self.position = position
-        self.velocity = velocity
         self.radius = radius
         self.mass = mass
         self.species = species
-        self.t_disk = np.zeros(n)
-        self.collisions_per_disk = np.zeros(n, dtype=np.int64)
-        self.t_last = np.full(n, -np.inf)
-        self.streak = np.zeros(n, dtype=np.int32)
         self.counters = np.zeros(loop.N_COUNTERS, dtype=np.int64)
         self.accumulators = np.zeros(loop.N_ACCUMULATORS)
         self.pair_collisions = np.zeros((self.n_species, self.n_species), dtype=np.int64)
         self.wall_impulse = np.zeros(4)
-        self.initial_energy = float(self.kinetic_energy())
+        self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
         self.rebase_every = 16 * n + 1024
+        self.reorder_every = (REORDER_EVENTS_PER_DISK * n if n >= REORDER_MIN_DISKS
+                              else np.iinfo(np.int64).max)
 
-        self._setup_shells(shell, list_capacity)
         v_rms = math.sqrt(2.0 * self.initial_energy / mass.sum()) if self.initial_energy else 1.0
         crossing_time = 2.0 * float(np.median(radius)) / v_rms
         self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
                                   else float(collapse_interval))
         self.collapse_streak = int(collapse_streak)
-        self._build()
+        self._build(position, velocity, shell, list_capacity)
 
     # -- construction ---------------------------------------------------------------------
-    def _setup_shells(self, shell, list_capacity):
+    def _build(self, position, velocity, shell, list_capacity):
+        """Size shells and cells, allocate the state, link neighbours, schedule events."""
         n, radius, box = self.n, self.radius, self.box
         median = float(np.median(radius))
         big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
@@ -201,9 +203,6 @@ class Engine:
                                      f"radius {max_small}: it must exceed 4 R")
                 delta_small = min(delta_small, limit)
         delta = np.full(n, delta_small)
-        self.delta = delta
-        self.is_big = is_big
-        self.big = big.astype(np.int32)
         reach = max_small + delta_small
         cells = np.maximum(1, np.floor(box / (2.0 * reach)).astype(np.int64))
         self.geometry = np.array([box[0], box[1], box[0] / cells[0], box[1] / cells[1], reach])
@@ -218,69 +217,82 @@ class Engine:
             density = max(phi_small, 0.6) / (np.pi * median**2)
             reach_big = radius[big] + delta[big] + reach
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
-        self.nb_cap = cap
-        self.nb_start = np.zeros(n, dtype=np.int64)
-        self.nb_start[1:] = np.cumsum(cap[:-1], dtype=np.int64)
-        self.nb = np.full(int(cap.sum()), -1, dtype=np.int32)
-        self.nb_count = np.zeros(n, dtype=np.int32)
-        self.center = np.zeros((n, 2))
-        self.cell_head = np.full(int(cells[0] * cells[1]), -1, dtype=np.int32)
-        self.cell_next = np.full(n, -1, dtype=np.int32)
-        self.cell_prev = np.full(n, -1, dtype=np.int32)
-        self.cell_of = np.full(n, -1, dtype=np.int32)
+        nb_start = np.zeros(n, dtype=np.int64)
+        nb_start[1:] = np.cumsum(cap[:-1], dtype=np.int64)
+        minus_one = np.full(n, -1, dtype=np.int32)
+        heap, slot = empty_queue(n)
+        self.disks = DiskArrays(
+            position=position, velocity=velocity, t_disk=np.zeros(n), center=np.zeros((n, 2)),
+            delta=delta, radius=radius.copy(), mass=self.mass.copy(),
+            species=self.species.copy(), is_big=is_big, coll_count=np.zeros(n, np.int64),
+            t_last=np.full(n, -np.inf), streak=np.zeros(n, np.int32),
+            event_time=np.empty(n), event_partner=np.empty(n, np.int32),
+            event_count=np.zeros(n, np.int64), slot=slot, nb_start=nb_start, nb_cap=cap,
+            nb_count=np.zeros(n, np.int32), cell_next=minus_one.copy(),
+            cell_prev=minus_one.copy(), cell_of=minus_one.copy(), order=np.arange(n),
+            nb=np.full(int(cap.sum()), -1, dtype=np.int32), heap=heap,
+            big=big.astype(np.int32),
+            cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32))
         self.packing_fraction = phi
-
-    def _build(self):
+        d = self.disks
         while True:
-            full = build_all_neighbours(self.position, self.center, self.delta, self.radius,
-                                        self.is_big, self.nb_start, self.nb_cap, self.nb_count,
-                                        self.nb, self.cell_head, self.cell_next,
-                                        self.cell_prev, self.cell_of, self.big, self.geometry,
-                                        self.grid)
+            full = build_all_neighbours(d.position, d.center, d.delta, d.radius, d.is_big,
+                                        d.nb_start, d.nb_cap, d.nb_count, d.nb, d.cell_head,
+                                        d.cell_next, d.cell_prev, d.cell_of, d.big,
+                                        self.geometry, self.grid)
             if full < 0:
                 break
             self._grow_lists(full)
-        self.event_time = np.empty(self.n)
-        self.event_partner = np.empty(self.n, dtype=np.int32)
-        self.event_count = np.zeros(self.n, dtype=np.int64)
-        loop.predict_all(0.0, self.position, self.velocity, self.t_disk, self.center,
-                         self.delta, self.radius, self.collisions_per_disk, self.event_time,
-                         self.event_partner, self.event_count, self.nb_start, self.nb_count,
-                         self.nb, self.geometry, self.grid)
-        self.heap, self.slot = empty_queue(self.n)
-        build_heap(self.heap, self.slot, self.event_time)
+        loop.predict_all(0.0, d.position, d.velocity, d.t_disk, d.center, d.delta, d.radius,
+                         d.coll_count, d.event_time, d.event_partner, d.event_count,
+                         d.nb_start, d.nb_count, d.nb, self.geometry, self.grid)
+        build_heap(d.heap, d.slot, d.event_time)
+        if n >= REORDER_MIN_DISKS:
+            self.reorder()
 
     def _grow_lists(self, full):
-        disks = np.union1d([full], np.flatnonzero(self.nb_count >= self.nb_cap))
-        self.nb_start, self.nb_cap, self.nb_count, self.nb = grow_lists(
-            self.nb_start, self.nb_cap, self.nb_count, self.nb, disks)
+        d = self.disks
+        disks = np.union1d([full], np.flatnonzero(d.nb_count >= d.nb_cap))
+        d.nb_start, d.nb_cap, d.nb_count, d.nb = grow_lists(d.nb_start, d.nb_cap, d.nb_count,
+                                                            d.nb, disks)
+
+    def reorder(self):
+        """Renumber disks in row order of their grid cells (big disks last) for locality."""
+        cell = self.disks.cell_of.astype(np.int64)
+        cell[cell < 0] = self.disks.cell_head.size
+        self.disks.permute(np.argsort(cell, kind="stable"))
 
     # -- running --------------------------------------------------------------------------
     def _run_chunk(self, max_events, max_collisions, t_stop, dissipation_limit):
         while True:
+            d = self.disks
+            reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
             status, disk = loop.run_events(
-                self.position, self.velocity, self.t_disk, self.center, self.delta,
-                self.radius, self.mass, self.species, self.collisions_per_disk, self.t_last,
-                self.streak, self.event_time, self.event_partner, self.event_count, self.heap,
-                self.slot, self.nb_start, self.nb_cap, self.nb_count, self.nb, self.cell_head,
-                self.cell_next, self.cell_prev, self.cell_of, self.big, self.geometry,
+                d.position, d.velocity, d.t_disk, d.center, d.delta, d.radius, d.mass,
+                d.species, d.coll_count, d.t_last, d.streak, d.event_time, d.event_partner,
+                d.event_count, d.heap, d.slot, d.nb_start, d.nb_cap, d.nb_count, d.nb,
+                d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
                 self.grid, self.restitution, self.wall_restitution, self.tc, self.counters,
                 self.accumulators, self.pair_collisions, self.wall_impulse,
-                max_events, max_collisions, t_stop, dissipation_limit,
+                min(max_events, reorder_at), max_collisions, t_stop, dissipation_limit,
                 self.collapse_interval, self.collapse_streak, self.rebase_every)
+            if status == loop.STATUS_EVENT_LIMIT and self.counters[loop.EVENTS] == reorder_at:
+                self.reorder()
+                if reorder_at < max_events:
+                    continue
             if status == loop.STATUS_LIST_FULL:
                 self._grow_lists(disk)
                 continue
             if status == loop.STATUS_STALLED:
                 raise StalledError(
                     f"the clock is stuck at t = {self.time:.17g}: more than 16 N + 1000 events "
-                    f"in a row at one instant, last for disk {disk} at position "
-                    f"{self.position[disk].tolist()} with velocity "
-                    f"{self.velocity[disk].tolist()}; the state is beyond float64 resolution "
+                    f"in a row at one instant, last for disk {d.order[disk]} at position "
+                    f"{d.position[disk].tolist()} with velocity "
+                    f"{d.velocity[disk].tolist()}; the state is beyond float64 resolution "
                     f"(for inelastic disks, switch on the TC model)")
             if status == loop.STATUS_COLLAPSE:
-                cluster = np.flatnonzero(self.streak >= 2)
-                raise InelasticCollapseError(sorted(set(cluster.tolist()) | {int(disk)}),
+                cluster = set(np.flatnonzero(d.streak >= 2).tolist()) | {int(disk)}
+                raise InelasticCollapseError(sorted(int(d.order[k]) for k in cluster),
                                              self.time, self.collisions)
             return status
 
@@ -350,19 +362,41 @@ class Engine:
         """Σ r_ij·Δp_i over all disk–disk contacts so far."""
         return float(self.accumulators[loop.VIRIAL])
 
+    def _user_order(self, values):
+        out = np.empty_like(values)
+        out[self.disks.order] = values
+        return out
+
     def positions(self, t=None):
-        """Positions of every disk at absolute time ``t`` (default: the current time)."""
+        """Positions float64[n, 2] of every disk at absolute time ``t`` (default: the time of
+        the last event); ``t`` must not precede the last event."""
         t_rel = (self.accumulators[loop.T_NOW] if t is None
                  else float(t) - self.accumulators[loop.T_ORIGIN])
-        return loop.positions_at(t_rel, self.position, self.velocity, self.t_disk,
-                                 self.geometry, self.grid)
+        d = self.disks
+        return self._user_order(loop.positions_at(t_rel, d.position, d.velocity, d.t_disk,
+                                                  self.geometry, self.grid))
+
+    def velocities(self):
+        """Velocities float64[n, 2] (constant between events)."""
+        return self._user_order(self.disks.velocity)
+
+    def collisions_by_disk(self):
+        """Contacts (disk and wall) of each disk so far: int64[n]."""
+        return self._user_order(self.disks.coll_count)
+
+    def next_event_time(self):
+        """Absolute time of the next scheduled event (possibly stale)."""
+        d = self.disks
+        return float(d.event_time[d.heap[0]] + self.accumulators[loop.T_ORIGIN])
 
     def kinetic_energy_by_species(self):
-        return loop.kinetic_energy_by_species(self.velocity, self.mass, self.species,
-                                              self.n_species)
+        d = self.disks
+        return loop.kinetic_energy_by_species(d.velocity, d.mass, d.species, self.n_species)
 
     def kinetic_energy(self):
-        return float(np.sum(0.5 * self.mass * np.sum(self.velocity**2, axis=1)))
+        d = self.disks
+        return float(np.sum(0.5 * d.mass * np.sum(d.velocity**2, axis=1)))
 
     def momentum(self):
-        return (self.mass[:, None] * self.velocity).sum(axis=0)
+        d = self.disks
+        return (d.mass[:, None] * d.velocity).sum(axis=0)
