@@ -18,7 +18,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)  ## make the virtual environment and install sim into it
 
 run: $(STAMP)  ## run the default scene
-	$(PY) -m sim.demo
+	$(PY) -m sim
 
 test: $(STAMP)  ## quick tests (long physics runs are marked slow)
 	$(PY) -m pytest -q

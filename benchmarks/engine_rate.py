@@ -2,9 +2,10 @@
 
 Elastic disks in a periodic unit box, started from a lattice (or random placement when
 dilute) and equilibrated for ``--warmup`` collisions per disk before timing; one thread.
-Columns: collisions_per_s and events_per_s (events include neighbour-shell exits),
+Columns: collisions_per_s and events_per_s (every event the engine applies: disk and wall
+contacts and neighbour-shell exits),
 bytes_per_disk (engine arrays) and rss_bytes_per_disk (peak resident-set growth),
-compile_s (first compiled call in this process: compilation or cache load), and
+compile_s (first engine built and run in this process: compilation or cache load), and
 reference_ratio (this engine over the textbook reference engine, same N and φ, same process,
 N ≤ 10⁴). Extra rows compare effects: ξ < 1 with TC, and the crater bed with and without
 its projectile.
@@ -48,19 +49,22 @@ def peak_rss_bytes():
 
 
 def timed_rate(engine, collisions):
-    c0, e0 = engine.collisions, engine.events
+    c0, e0 = engine.collisions, engine.steps
     started = time.perf_counter()
     engine.run(collisions=c0 + collisions)
     seconds = time.perf_counter() - started
-    return (engine.collisions - c0) / seconds, (engine.events - e0) / seconds
+    return (engine.collisions - c0) / seconds, (engine.steps - e0) / seconds
 
 
-def first_call(engine):
+def build(*args, **kwargs):
+    """Engine(*args, **kwargs); the first one in the process is timed together with its first
+    compiled call: that is the compilation (or cache-loading) time of this process."""
+    started = time.perf_counter()
+    engine = Engine(*args, **kwargs)
     if FIRST_CALL["seconds"] is None:
-        started = time.perf_counter()
         engine.run(events=engine.events + 1)
         FIRST_CALL["seconds"] = time.perf_counter() - started
-    return FIRST_CALL["seconds"]
+    return engine
 
 
 def reference_rate(position, velocity, radius, events):
@@ -75,9 +79,9 @@ def reference_rate(position, velocity, radius, events):
 def gas_row(n, phi, collisions, warmup, reference_events, **effects):
     rss_before = peak_rss_bytes()
     position, velocity, radius = equal_disks(n, phi)
-    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
-                    **effects)
-    compile_s = first_call(engine)
+    engine = build(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
+                   **effects)
+    compile_s = FIRST_CALL["seconds"]
     engine.run(collisions=engine.collisions + int(warmup * n))
     coll_rate, event_rate = timed_rate(engine, collisions)
     row = {"scene": "gas" if not effects else "gas " + " ".join(
@@ -110,15 +114,14 @@ def crater_rows(collisions, seed=1):
         else:
             position, radius, mass = bed, r_bed, 1.0
             velocity = fixed_speed(n_bed, 1.0, seed=seed + 1)
-        engine = Engine(position, velocity, radius, mass, restitution=0.5, tc=1e-8)
-        first_call(engine)
+        engine = build(position, velocity, radius, mass, restitution=0.5, tc=1e-8)
         started = time.perf_counter()
         engine.run(collisions=collisions, energy_fraction=0.1)
         seconds = time.perf_counter() - started
         rows.append({"scene": "crater" if with_projectile else "crater bed, no projectile",
                      "n": engine.n, "phi": round(engine.packing_fraction, 3),
                      "collisions_per_s": round(engine.collisions / seconds),
-                     "events_per_s": round(engine.events / seconds),
+                     "events_per_s": round(engine.steps / seconds),
                      "bytes_per_disk": round(engine_bytes(engine) / engine.n, 1),
                      "rss_bytes_per_disk": None, "compile_s": None, "reference_ratio": None})
     return rows

@@ -12,17 +12,19 @@ TC model (Luding & McNamara, Granular Matter 1, 113 (1998)): a contact is elasti
 partner touched anything — disk or wall — less than ``t_c`` ago. Wall contacts count, so a
 disk trapped between a wall and its neighbours cannot collapse against the wall either.
 
-Each function returns ``(dissipated energy, virial term)`` and updates velocities in place:
-``velocity: float64[n, 2]``, ``mass: float64[n]``.
+Each function returns ``(dissipated energy, virial term)`` and updates velocities in place in
+the disk table ``disks`` (columns in :mod:`sim.kinematics`), ``mass: float64[n]``.
 """
 
 import math
 
 from numba import njit
 
+from sim.kinematics import VX, VY
+
 
 @njit(cache=True, inline="always")
-def collide_disks(i, j, rx, ry, xi, velocity, mass):
+def collide_disks(i, j, rx, ry, xi, disks, mass):
     """Apply the impulse of a contact between disks i and j at separation r = r_i - r_j.
 
     Returns (energy dissipated, r·Δp_i). Disks found separating (v_n ≥ 0, possible only by
@@ -31,27 +33,27 @@ def collide_disks(i, j, rx, ry, xi, velocity, mass):
     r = math.sqrt(rx * rx + ry * ry)
     nx = rx / r
     ny = ry / r
-    v_n = (velocity[i, 0] - velocity[j, 0]) * nx + (velocity[i, 1] - velocity[j, 1]) * ny
+    v_n = (disks[i, VX] - disks[j, VX]) * nx + (disks[i, VY] - disks[j, VY]) * ny
     if v_n >= 0.0:
         return 0.0, 0.0
     m_i = mass[i]
     m_j = mass[j]
     mu = m_i * m_j / (m_i + m_j)
     impulse = (1.0 + xi) * mu * v_n
-    velocity[i, 0] -= impulse / m_i * nx
-    velocity[i, 1] -= impulse / m_i * ny
-    velocity[j, 0] += impulse / m_j * nx
-    velocity[j, 1] += impulse / m_j * ny
+    disks[i, VX] -= impulse / m_i * nx
+    disks[i, VY] -= impulse / m_i * ny
+    disks[j, VX] += impulse / m_j * nx
+    disks[j, VY] += impulse / m_j * ny
     return 0.5 * (1.0 - xi * xi) * mu * v_n * v_n, -impulse * r
 
 
 @njit(cache=True, inline="always")
-def reflect_from_wall(i, axis, xi_wall, velocity, mass):
+def reflect_from_wall(i, axis, xi_wall, disks, mass):
     """Reverse the normal velocity of disk i at a wall normal to ``axis``.
 
     Returns (energy dissipated, momentum given to the wall along the axis).
     """
-    v_n = velocity[i, axis]
-    velocity[i, axis] = -xi_wall * v_n
+    v_n = disks[i, VX + axis]
+    disks[i, VX + axis] = -xi_wall * v_n
     m = mass[i]
     return 0.5 * (1.0 - xi_wall * xi_wall) * m * v_n * v_n, m * (1.0 + xi_wall) * v_n

@@ -18,9 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim import event_loop as loop
-from sim.event_queue import build_heap, empty_queue
+from sim.event_queue import build_queue, empty_queue
+from sim.kinematics import RADIUS, VX, VY, X, Y
 from sim.neighbours import build_all_neighbours, grow_lists
-from sim.state import DiskArrays
+from sim.state import DiskArrays, disk_table
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
 #: φ = 0.5 and about 4.6 at φ = 0.1); interpolated linearly between the points.
@@ -220,33 +221,35 @@ class Engine:
         nb_start = np.zeros(n, dtype=np.int64)
         nb_start[1:] = np.cumsum(cap[:-1], dtype=np.int64)
         minus_one = np.full(n, -1, dtype=np.int32)
-        heap, slot = empty_queue(n)
+        heap, links, list_head, calendar, block_rate = empty_queue(n)
+        table = disk_table(n)
+        table[:, X:Y + 1] = position
+        table[:, VX:VY + 1] = velocity
+        table[:, RADIUS] = radius
         self.disks = DiskArrays(
-            position=position, velocity=velocity, t_disk=np.zeros(n), center=np.zeros((n, 2)),
-            delta=delta, radius=radius.copy(), mass=self.mass.copy(),
-            species=self.species.copy(), is_big=is_big, coll_count=np.zeros(n, np.int64),
-            t_last=np.full(n, -np.inf), streak=np.zeros(n, np.int32),
-            event_time=np.empty(n), event_partner=np.empty(n, np.int32),
-            event_count=np.zeros(n, np.int64), slot=slot, nb_start=nb_start, nb_cap=cap,
-            nb_count=np.zeros(n, np.int32), cell_next=minus_one.copy(),
-            cell_prev=minus_one.copy(), cell_of=minus_one.copy(), order=np.arange(n),
-            nb=np.full(int(cap.sum()), -1, dtype=np.int32), heap=heap,
+            table=table, delta=delta, mass=self.mass.copy(), species=self.species.copy(),
+            is_big=is_big, coll_count=np.zeros(n, np.int64), t_last=np.full(n, -np.inf),
+            streak=np.zeros(n, np.int32), event_time=np.empty(n),
+            event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int64),
+            links=links, nb_start=nb_start, nb_cap=cap, nb_count=np.zeros(n, np.int32),
+            cell_next=minus_one.copy(), cell_prev=minus_one.copy(), cell_of=minus_one.copy(),
+            order=np.arange(n), nb=np.full(int(cap.sum()), -1, dtype=np.int32), heap=heap,
+            list_head=list_head, calendar=calendar, block_rate=block_rate,
             big=big.astype(np.int32),
             cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32))
         self.packing_fraction = phi
         d = self.disks
         while True:
-            full = build_all_neighbours(d.position, d.center, d.delta, d.radius, d.is_big,
-                                        d.nb_start, d.nb_cap, d.nb_count, d.nb, d.cell_head,
-                                        d.cell_next, d.cell_prev, d.cell_of, d.big,
-                                        self.geometry, self.grid)
+            full = build_all_neighbours(d.table, d.delta, d.is_big, d.nb_start, d.nb_cap,
+                                        d.nb_count, d.nb, d.cell_head, d.cell_next,
+                                        d.cell_prev, d.cell_of, d.big, self.geometry,
+                                        self.grid)
             if full < 0:
                 break
             self._grow_lists(full)
-        loop.predict_all(0.0, d.position, d.velocity, d.t_disk, d.center, d.delta, d.radius,
-                         d.coll_count, d.event_time, d.event_partner, d.event_count,
-                         d.nb_start, d.nb_count, d.nb, self.geometry, self.grid)
-        build_heap(d.heap, d.slot, d.event_time)
+        loop.predict_all(0.0, d.table, d.delta, d.coll_count, d.event_time, d.event_partner,
+                         d.event_count, d.nb_start, d.nb_count, d.nb, self.geometry, self.grid)
+        build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()
 
@@ -263,18 +266,19 @@ class Engine:
         self.disks.permute(np.argsort(cell, kind="stable"))
 
     # -- running --------------------------------------------------------------------------
-    def _run_chunk(self, max_events, max_collisions, t_stop, dissipation_limit):
+    def _run_chunk(self, max_events, max_contacts, max_collisions, t_stop, dissipation_limit):
         while True:
             d = self.disks
             reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
             status, disk = loop.run_events(
-                d.position, d.velocity, d.t_disk, d.center, d.delta, d.radius, d.mass,
-                d.species, d.coll_count, d.t_last, d.streak, d.event_time, d.event_partner,
-                d.event_count, d.heap, d.slot, d.nb_start, d.nb_cap, d.nb_count, d.nb,
+                d.table, d.delta, d.mass, d.species, d.coll_count, d.t_last, d.streak,
+                d.event_time, d.event_partner, d.event_count, *d.queue, d.nb_start, d.nb_cap,
+                d.nb_count, d.nb,
                 d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
                 self.grid, self.restitution, self.wall_restitution, self.tc, self.counters,
                 self.accumulators, self.pair_collisions, self.wall_impulse,
-                min(max_events, reorder_at), max_collisions, t_stop, dissipation_limit,
+                min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
+                dissipation_limit,
                 self.collapse_interval, self.collapse_streak, self.rebase_every)
             if status == loop.STATUS_EVENT_LIMIT and self.counters[loop.EVENTS] == reorder_at:
                 self.reorder()
@@ -287,8 +291,8 @@ class Engine:
                 raise StalledError(
                     f"the clock is stuck at t = {self.time:.17g}: more than 16 N + 1000 events "
                     f"in a row at one instant, last for disk {d.order[disk]} at position "
-                    f"{d.position[disk].tolist()} with velocity "
-                    f"{d.velocity[disk].tolist()}; the state is beyond float64 resolution "
+                    f"{d.table[disk, X:Y + 1].tolist()} with velocity "
+                    f"{d.table[disk, VX:VY + 1].tolist()}; the state is beyond float64 resolution "
                     f"(for inelastic disks, switch on the TC model)")
             if status == loop.STATUS_COLLAPSE:
                 cluster = set(np.flatnonzero(d.streak >= 2).tolist()) | {int(disk)}
@@ -300,8 +304,8 @@ class Engine:
             wall_seconds=None, until=None, chunk_events=200_000):
         """Advance until the first stop condition holds; returns its name.
 
-        events, collisions : totals since the start of the engine (applied events include
-            disk and wall contacts and neighbour-shell exits)
+        events : disk and wall contacts since the start of the engine
+        collisions : disk–disk contacts since the start of the engine
         time : absolute simulated time; the run stops at the last event not after it
         energy_fraction : stop once the kinetic energy is this fraction of the initial one
         wall_seconds : wall-clock budget of this call, checked between chunks
@@ -312,22 +316,21 @@ class Engine:
                                    until)):
             raise ValueError("run() needs at least one stop condition")
         big = np.iinfo(np.int64).max
-        max_events = big if events is None else int(events)
+        max_contacts = big if events is None else int(events)
         max_collisions = big if collisions is None else int(collisions)
         t_stop = math.inf if time is None else float(time)
         dissipation_limit = (math.inf if energy_fraction is None
                              else self.initial_energy * (1.0 - float(energy_fraction)))
         started = wallclock.perf_counter()
-        reasons = {loop.STATUS_COLLISION_LIMIT: "collisions", loop.STATUS_TIME_REACHED: "time",
+        reasons = {loop.STATUS_COLLISION_LIMIT: "collisions", loop.STATUS_CONTACT_LIMIT: "events",
+                   loop.STATUS_TIME_REACHED: "time",
                    loop.STATUS_ENERGY_REACHED: "energy_fraction",
                    loop.STATUS_NO_EVENTS: "no_events"}
         while True:
-            chunk_end = min(max_events, int(self.counters[loop.EVENTS]) + int(chunk_events))
-            status = self._run_chunk(chunk_end, max_collisions, t_stop, dissipation_limit)
-            if status == loop.STATUS_EVENT_LIMIT:
-                if self.counters[loop.EVENTS] >= max_events:
-                    return "events"
-            else:
+            chunk_end = int(self.counters[loop.EVENTS]) + int(chunk_events)
+            status = self._run_chunk(chunk_end, max_contacts, max_collisions, t_stop,
+                                     dissipation_limit)
+            if status != loop.STATUS_EVENT_LIMIT:
                 return reasons[status]
             if wall_seconds is not None and wallclock.perf_counter() - started >= wall_seconds:
                 return "wall_seconds"
@@ -350,6 +353,12 @@ class Engine:
 
     @property
     def events(self):
+        """Disk–disk and disk–wall contacts so far."""
+        return self.collisions + self.wall_collisions
+
+    @property
+    def steps(self):
+        """Events the engine applied: contacts and neighbour-shell exits."""
         return int(self.counters[loop.EVENTS])
 
     @property
@@ -362,6 +371,27 @@ class Engine:
         """Σ r_ij·Δp_i over all disk–disk contacts so far."""
         return float(self.accumulators[loop.VIRIAL])
 
+    # -- checkpoints ----------------------------------------------------------------------
+    def state_dict(self):
+        """Every array that evolves, by name: restoring it into an engine built from the same
+        inputs continues the run to the same bits."""
+        state = {f"disks/{name}": value for name, value in vars(self.disks).items()}
+        state.update(counters=self.counters, accumulators=self.accumulators,
+                     pair_collisions=self.pair_collisions, wall_impulse=self.wall_impulse,
+                     initial_energy=np.array(self.initial_energy))
+        return state
+
+    def load_state_dict(self, state):
+        """Replace the evolving arrays by those of :meth:`state_dict` (copied)."""
+        for key, value in state.items():
+            value = np.array(value)
+            if key.startswith("disks/"):
+                setattr(self.disks, key.removeprefix("disks/"), value)
+            elif key == "initial_energy":
+                self.initial_energy = float(value)
+            else:
+                setattr(self, key, value)
+
     def _user_order(self, values):
         out = np.empty_like(values)
         out[self.disks.order] = values
@@ -373,12 +403,11 @@ class Engine:
         t_rel = (self.accumulators[loop.T_NOW] if t is None
                  else float(t) - self.accumulators[loop.T_ORIGIN])
         d = self.disks
-        return self._user_order(loop.positions_at(t_rel, d.position, d.velocity, d.t_disk,
-                                                  self.geometry, self.grid))
+        return self._user_order(loop.positions_at(t_rel, d.table, self.geometry, self.grid))
 
     def velocities(self):
         """Velocities float64[n, 2] (constant between events)."""
-        return self._user_order(self.disks.velocity)
+        return self._user_order(self.disks.table[:, VX:VY + 1])
 
     def collisions_by_disk(self):
         """Contacts (disk and wall) of each disk so far: int64[n]."""
@@ -387,16 +416,16 @@ class Engine:
     def next_event_time(self):
         """Absolute time of the next scheduled event (possibly stale)."""
         d = self.disks
-        return float(d.event_time[d.heap[0]] + self.accumulators[loop.T_ORIGIN])
+        return float(d.event_time.min() + self.accumulators[loop.T_ORIGIN])
 
     def kinetic_energy_by_species(self):
         d = self.disks
-        return loop.kinetic_energy_by_species(d.velocity, d.mass, d.species, self.n_species)
+        return loop.kinetic_energy_by_species(d.table, d.mass, d.species, self.n_species)
 
     def kinetic_energy(self):
         d = self.disks
-        return float(np.sum(0.5 * d.mass * np.sum(d.velocity**2, axis=1)))
+        return float(np.sum(0.5 * d.mass * np.sum(d.table[:, VX:VY + 1] ** 2, axis=1)))
 
     def momentum(self):
         d = self.disks
-        return (d.mass[:, None] * d.velocity).sum(axis=0)
+        return (d.mass[:, None] * d.table[:, VX:VY + 1]).sum(axis=0)

@@ -5,10 +5,11 @@ Each disk owns one scheduled event, the earliest of (Smallenburg, Eur. Phys. J. 
     collision counter still equals the value recorded at prediction;
   * a contact with a wall (``partner = WALL_X_LOW … WALL_Y_HIGH``);
   * its exit from its neighbour shell (``partner = SHELL_EXIT``), which rebuilds its list.
-Positions are advanced lazily: disk i is stored at ``position[i]`` at its own time
-``t_disk[i]``. Every ``rebase_every`` events all disks are brought to the current time and the
-clock restarts from zero (its origin kept in ``accumulators[T_ORIGIN]``), so long runs keep
-full float64 precision. Stale events are re-predicted, never applied.
+Positions are advanced lazily: disk i is stored at ``disks[i, X:Y+1]`` at its own time
+``disks[i, T_OWN]`` (disk table columns in :mod:`sim.kinematics`). Every ``rebase_every``
+events all disks are brought to the current time and the clock restarts from zero (its
+origin kept in ``accumulators[T_ORIGIN]``), so long runs keep full float64 precision. Stale
+events are re-predicted, never applied.
 
 Optional effects arrive as arguments that are either ``None`` or a value; numba compiles one
 loop per combination and removes the code of every effect that is ``None``:
@@ -21,9 +22,17 @@ import numpy as np
 from numba import njit
 
 from sim.collision_rules import collide_disks, reflect_from_wall
-from sim.event_queue import reschedule
+from sim.event_queue import build_queue, earliest, reschedule
 from sim.kinematics import (
+    CX,
+    CY,
     INF,
+    RADIUS,
+    T_OWN,
+    VX,
+    VY,
+    X,
+    Y,
     minimum_image,
     pair_contact_time,
     shell_exit_time,
@@ -46,6 +55,7 @@ STATUS_COLLISION_LIMIT = 2
 STATUS_TIME_REACHED = 3
 STATUS_ENERGY_REACHED = 4
 STATUS_NO_EVENTS = 5
+STATUS_CONTACT_LIMIT = 6
 STATUS_COLLAPSE = -1
 STATUS_LIST_FULL = -2
 STATUS_STALLED = -3
@@ -68,46 +78,47 @@ N_ACCUMULATORS = 5
 
 
 @njit(cache=True, inline="always")
-def advance(i, t, position, velocity, t_disk, geometry, grid):
+def advance(i, t, disks, geometry, grid):
     """Move disk i along its straight path to time t."""
-    dt = t - t_disk[i]
-    position[i, 0] = wrap(position[i, 0] + velocity[i, 0] * dt, geometry[0], grid[2] != 0)
-    position[i, 1] = wrap(position[i, 1] + velocity[i, 1] * dt, geometry[1], grid[3] != 0)
-    t_disk[i] = t
+    dt = t - disks[i, T_OWN]
+    disks[i, X] = wrap(disks[i, X] + disks[i, VX] * dt, geometry[0], grid[2] != 0)
+    disks[i, Y] = wrap(disks[i, Y] + disks[i, VY] * dt, geometry[1], grid[3] != 0)
+    disks[i, T_OWN] = t
 
 
 @njit(cache=True, inline="always")
-def predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
-            event_time, event_partner, event_count, nb_start, nb_count, nb, geometry, grid):
-    """Schedule the earliest event of disk i at time t (its position taken lazily)."""
+def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
+            nb_count, nb, geometry, grid):
+    """Schedule the earliest event of disk i, which must be at time t already."""
     px = grid[2] != 0
     py = grid[3] != 0
-    vx = velocity[i, 0]
-    vy = velocity[i, 1]
-    x = position[i, 0] + vx * (t - t_disk[i])
-    y = position[i, 1] + vy * (t - t_disk[i])
-    tau = shell_exit_time(minimum_image(x - center[i, 0], geometry[0], px),
-                          minimum_image(y - center[i, 1], geometry[1], py), vx, vy, delta[i])
+    x = disks[i, X]
+    y = disks[i, Y]
+    vx = disks[i, VX]
+    vy = disks[i, VY]
+    r_i = disks[i, RADIUS]
+    tau = shell_exit_time(minimum_image(x - disks[i, CX], geometry[0], px),
+                          minimum_image(y - disks[i, CY], geometry[1], py), vx, vy, delta[i])
     partner = SHELL_EXIT
     if not px:
-        tau_w, side = wall_contact_time(x, vx, radius[i], geometry[0])
+        tau_w, side = wall_contact_time(x, vx, r_i, geometry[0])
         if tau_w < tau:
             tau = tau_w
             partner = WALL_X_LOW - side
     if not py:
-        tau_w, side = wall_contact_time(y, vy, radius[i], geometry[1])
+        tau_w, side = wall_contact_time(y, vy, r_i, geometry[1])
         if tau_w < tau:
             tau = tau_w
             partner = WALL_Y_LOW - side
-    r_i = radius[i]
     start = nb_start[i]
     for k in range(start, start + nb_count[i]):
         j = nb[k]
-        dt = t - t_disk[j]
-        rx = minimum_image(x - position[j, 0] - velocity[j, 0] * dt, geometry[0], px)
-        ry = minimum_image(y - position[j, 1] - velocity[j, 1] * dt, geometry[1], py)
-        tau_ij = pair_contact_time(rx, ry, vx - velocity[j, 0], vy - velocity[j, 1],
-                                   r_i + radius[j])
+        dt = t - disks[j, T_OWN]
+        vx_j = disks[j, VX]
+        vy_j = disks[j, VY]
+        rx = minimum_image(x - disks[j, X] - vx_j * dt, geometry[0], px)
+        ry = minimum_image(y - disks[j, Y] - vy_j * dt, geometry[1], py)
+        tau_ij = pair_contact_time(rx, ry, vx - vx_j, vy - vy_j, r_i + disks[j, RADIUS])
         if tau_ij < tau:
             tau = tau_ij
             partner = j
@@ -119,58 +130,88 @@ def predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
         event_count[i] = coll_count[partner]
 
 
-@njit(cache=True, _nrt=False)
-def rebase_clock(position, velocity, t_disk, t_last, event_time, geometry, grid, accumulators):
-    """Bring every disk to the current time and restart the clock there (order-preserving)."""
+@njit(cache=True, _nrt=False, error_model="numpy")
+def rebase_clock(disks, t_last, event_time, heap, links, list_head, calendar, block_rate,
+                 geometry, grid, accumulators):
+    """Bring every disk to the current time and restart the clock there (order-preserving);
+    the event queue is rebuilt for the shifted times."""
     t0 = accumulators[T_NOW]
-    for i in range(position.shape[0]):
-        advance(i, t0, position, velocity, t_disk, geometry, grid)
-        t_disk[i] = 0.0
+    for i in range(disks.shape[0]):
+        advance(i, t0, disks, geometry, grid)
+        disks[i, T_OWN] = 0.0
         t_last[i] -= t0
         event_time[i] -= t0
     accumulators[T_ORIGIN] += t0
     accumulators[T_NOW] = 0.0
+    build_queue(heap, links, list_head, calendar, block_rate, event_time, 0.0)
 
 
-@njit(cache=True, _nrt=False)
-def run_events(position, velocity, t_disk, center, delta, radius, mass, species,
-               coll_count, t_last, streak, event_time, event_partner, event_count, heap, slot,
+@njit(cache=True, _nrt=False, error_model="numpy")
+def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_time,
+               event_partner, event_count, heap, links, list_head, calendar, block_rate,
                nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_prev, cell_of, big,
                geometry, grid, restitution, wall_restitution, tc,
                counters, accumulators, pair_collisions, wall_impulse,
-               max_events, max_collisions, t_stop, dissipation_limit,
+               max_events, max_contacts, max_collisions, t_stop, dissipation_limit,
                collapse_dt, collapse_streak, rebase_every):
     """Process events in time order until a limit is met; see the module docstring.
 
-    Limits: ``max_events`` and ``max_collisions`` are totals of ``counters``, ``t_stop`` is an
+    Limits: ``max_events`` (applied events, shell exits included: the chunk size),
+    ``max_contacts`` (disk and wall contacts) and ``max_collisions`` (disk contacts) are
+    totals of ``counters``, ``t_stop`` is an
     absolute time (events after it stay scheduled), ``dissipation_limit`` the energy whose
     dissipation ends the run. Inelastic collapse: a disk with more than ``collapse_streak``
     consecutive dissipative contacts, each less than ``collapse_dt`` after its previous
     contact (contacts made elastic by the TC model break the streak). A stall — more than
     16 N + 1000 events in a row at one instant — ends the loop instead of hanging it.
+
+    Counters and accumulators live in local variables (registers) during the loop and are
+    written back to ``counters`` and ``accumulators`` when it stops.
     """
     dissipative = restitution is not None or wall_restitution is not None
+    events = counters[EVENTS]
+    disk_collisions = counters[DISK_COLLISIONS]
+    wall_collisions = counters[WALL_COLLISIONS]
+    shell_exits = counters[SHELL_EXITS]
+    stale_events = counters[STALE_EVENTS]
+    t_now = accumulators[T_NOW]
+    dissipated_disks = accumulators[DISSIPATED_DISKS]
+    dissipated_walls = accumulators[DISSIPATED_WALLS]
+    virial_sum = accumulators[VIRIAL]
     t_stop_rel = t_stop - accumulators[T_ORIGIN]
+    events_to_rebase = rebase_every - events % rebase_every
+    status = 0
+    culprit = -1
     t_previous = -INF
     stalled = 0
-    stall_limit = 16 * position.shape[0] + 1000
+    stall_limit = 16 * disks.shape[0] + 1000
     while True:
-        if counters[EVENTS] >= max_events:
-            return STATUS_EVENT_LIMIT, -1
-        if counters[DISK_COLLISIONS] >= max_collisions:
-            return STATUS_COLLISION_LIMIT, -1
-        if accumulators[DISSIPATED_DISKS] + accumulators[DISSIPATED_WALLS] >= dissipation_limit:
-            return STATUS_ENERGY_REACHED, -1
-        i = heap[0]
+        if events >= max_events:
+            status = STATUS_EVENT_LIMIT
+            break
+        if disk_collisions >= max_collisions:
+            status = STATUS_COLLISION_LIMIT
+            break
+        if disk_collisions + wall_collisions >= max_contacts:
+            status = STATUS_CONTACT_LIMIT
+            break
+        if dissipated_disks + dissipated_walls >= dissipation_limit:
+            status = STATUS_ENERGY_REACHED
+            break
+        i = earliest(heap, links, list_head, calendar, block_rate, event_time)
         t = event_time[i]
         if t > t_stop_rel:
-            return STATUS_TIME_REACHED, -1
+            status = STATUS_TIME_REACHED
+            break
         if t == INF:
-            return STATUS_NO_EVENTS, -1
+            status = STATUS_NO_EVENTS
+            break
         if t == t_previous:
             stalled += 1
             if stalled > stall_limit:
-                return STATUS_STALLED, i
+                status = STATUS_STALLED
+                culprit = i
+                break
         else:
             stalled = 0
             t_previous = t
@@ -178,25 +219,25 @@ def run_events(position, velocity, t_disk, center, delta, radius, mass, species,
         if partner >= 0:
             j = partner
             if coll_count[j] != event_count[i]:
-                counters[STALE_EVENTS] += 1
-                predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
-                        event_time, event_partner, event_count, nb_start, nb_count, nb,
-                        geometry, grid)
-                reschedule(heap, slot, event_time, i)
+                stale_events += 1
+                advance(i, t, disks, geometry, grid)
+                predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
+                        nb_start, nb_count, nb, geometry, grid)
+                reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
                 continue
-            advance(i, t, position, velocity, t_disk, geometry, grid)
-            advance(j, t, position, velocity, t_disk, geometry, grid)
-            rx = minimum_image(position[i, 0] - position[j, 0], geometry[0], grid[2] != 0)
-            ry = minimum_image(position[i, 1] - position[j, 1], geometry[1], grid[3] != 0)
+            advance(i, t, disks, geometry, grid)
+            advance(j, t, disks, geometry, grid)
+            rx = minimum_image(disks[i, X] - disks[j, X], geometry[0], grid[2] != 0)
+            ry = minimum_image(disks[i, Y] - disks[j, Y], geometry[1], grid[3] != 0)
             xi = 1.0
             if restitution is not None:
                 xi = restitution[species[i], species[j]]
                 if tc is not None:
                     if t - t_last[i] < tc or t - t_last[j] < tc:
                         xi = 1.0
-            lost, virial = collide_disks(i, j, rx, ry, xi, velocity, mass)
-            accumulators[DISSIPATED_DISKS] += lost
-            accumulators[VIRIAL] += virial
+            lost, virial = collide_disks(i, j, rx, ry, xi, disks, mass)
+            dissipated_disks += lost
+            virial_sum += virial
             s_i = species[i]
             s_j = species[j]
             if s_i <= s_j:
@@ -205,103 +246,117 @@ def run_events(position, velocity, t_disk, center, delta, radius, mass, species,
                 pair_collisions[s_j, s_i] += 1
             coll_count[i] += 1
             coll_count[j] += 1
-            counters[DISK_COLLISIONS] += 1
-            counters[EVENTS] += 1
+            disk_collisions += 1
+            events += 1
             if dissipative:
                 for d in (i, j):
                     streak[d] = streak[d] + 1 if (xi < 1.0 and t - t_last[d] < collapse_dt) else 0
                     t_last[d] = t
-                if streak[i] > collapse_streak:
-                    return STATUS_COLLAPSE, i
-                if streak[j] > collapse_streak:
-                    return STATUS_COLLAPSE, j
-            predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
-                    event_time, event_partner, event_count, nb_start, nb_count, nb,
-                    geometry, grid)
-            reschedule(heap, slot, event_time, i)
-            predict(j, t, position, velocity, t_disk, center, delta, radius, coll_count,
-                    event_time, event_partner, event_count, nb_start, nb_count, nb,
-                    geometry, grid)
-            reschedule(heap, slot, event_time, j)
+                if streak[i] > collapse_streak or streak[j] > collapse_streak:
+                    status = STATUS_COLLAPSE
+                    culprit = i if streak[i] > collapse_streak else j
+                    break
+            predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
+                    nb_start, nb_count, nb, geometry, grid)
+            reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
+            predict(j, t, disks, delta, coll_count, event_time, event_partner, event_count,
+                    nb_start, nb_count, nb, geometry, grid)
+            reschedule(heap, links, list_head, calendar, block_rate, event_time, j)
         elif partner == SHELL_EXIT:
-            advance(i, t, position, velocity, t_disk, geometry, grid)
-            full = rebuild_neighbours(i, position, center, delta, radius, nb_start, nb_cap,
-                                      nb_count, nb, cell_head, cell_next, cell_prev, cell_of,
-                                      big, geometry, grid)
+            advance(i, t, disks, geometry, grid)
+            full = rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb,
+                                      cell_head, cell_next, cell_prev, cell_of, big, geometry,
+                                      grid)
             if full >= 0:
-                return STATUS_LIST_FULL, full
-            counters[SHELL_EXITS] += 1
-            counters[EVENTS] += 1
-            predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
-                    event_time, event_partner, event_count, nb_start, nb_count, nb,
-                    geometry, grid)
-            reschedule(heap, slot, event_time, i)
+                status = STATUS_LIST_FULL
+                culprit = full
+                break
+            shell_exits += 1
+            events += 1
+            predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
+                    nb_start, nb_count, nb, geometry, grid)
+            reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
         else:
             wall = WALL_X_LOW - partner
             axis = wall >> 1
-            advance(i, t, position, velocity, t_disk, geometry, grid)
-            lo = radius[i]
-            hi = geometry[axis] - radius[i]
-            if position[i, axis] < lo:
-                position[i, axis] = lo
-            elif position[i, axis] > hi:
-                position[i, axis] = hi
+            advance(i, t, disks, geometry, grid)
+            lo = disks[i, RADIUS]
+            hi = geometry[axis] - disks[i, RADIUS]
+            if disks[i, X + axis] < lo:
+                disks[i, X + axis] = lo
+            elif disks[i, X + axis] > hi:
+                disks[i, X + axis] = hi
             xi_w = 1.0
             if wall_restitution is not None:
                 xi_w = wall_restitution
                 if tc is not None:
                     if t - t_last[i] < tc:
                         xi_w = 1.0
-            lost, impulse = reflect_from_wall(i, axis, xi_w, velocity, mass)
-            accumulators[DISSIPATED_WALLS] += lost
+            lost, impulse = reflect_from_wall(i, axis, xi_w, disks, mass)
+            dissipated_walls += lost
             wall_impulse[wall] += impulse
             coll_count[i] += 1
-            counters[WALL_COLLISIONS] += 1
-            counters[EVENTS] += 1
+            wall_collisions += 1
+            events += 1
             if dissipative:
                 streak[i] = streak[i] + 1 if (xi_w < 1.0 and t - t_last[i] < collapse_dt) else 0
                 t_last[i] = t
                 if streak[i] > collapse_streak:
-                    return STATUS_COLLAPSE, i
-            predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
-                    event_time, event_partner, event_count, nb_start, nb_count, nb,
-                    geometry, grid)
-            reschedule(heap, slot, event_time, i)
-        accumulators[T_NOW] = t
-        if counters[EVENTS] % rebase_every == 0:
-            rebase_clock(position, velocity, t_disk, t_last, event_time, geometry, grid,
-                         accumulators)
+                    status = STATUS_COLLAPSE
+                    culprit = i
+                    break
+            predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
+                    nb_start, nb_count, nb, geometry, grid)
+            reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
+        t_now = t
+        events_to_rebase -= 1
+        if events_to_rebase == 0:
+            accumulators[T_NOW] = t_now
+            rebase_clock(disks, t_last, event_time, heap, links, list_head, calendar,
+                         block_rate, geometry, grid, accumulators)
+            t_now = 0.0
             t_stop_rel = t_stop - accumulators[T_ORIGIN]
+            events_to_rebase = rebase_every
+    counters[EVENTS] = events
+    counters[DISK_COLLISIONS] = disk_collisions
+    counters[WALL_COLLISIONS] = wall_collisions
+    counters[SHELL_EXITS] = shell_exits
+    counters[STALE_EVENTS] = stale_events
+    accumulators[T_NOW] = t_now
+    accumulators[DISSIPATED_DISKS] = dissipated_disks
+    accumulators[DISSIPATED_WALLS] = dissipated_walls
+    accumulators[VIRIAL] = virial_sum
+    return status, culprit
 
 
-@njit(cache=True, _nrt=False)
-def predict_all(t, position, velocity, t_disk, center, delta, radius, coll_count,
-                event_time, event_partner, event_count, nb_start, nb_count, nb, geometry, grid):
+@njit(cache=True, _nrt=False, error_model="numpy")
+def predict_all(t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
+                nb_count, nb, geometry, grid):
     """Schedule the first event of every disk (all disks at time t)."""
-    for i in range(position.shape[0]):
-        predict(i, t, position, velocity, t_disk, center, delta, radius, coll_count,
-                event_time, event_partner, event_count, nb_start, nb_count, nb, geometry, grid)
+    for i in range(disks.shape[0]):
+        predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
+                nb_start, nb_count, nb, geometry, grid)
 
 
 @njit(cache=True)
-def positions_at(t, position, velocity, t_disk, geometry, grid):
+def positions_at(t, disks, geometry, grid):
     """Positions of all disks at time t (relative clock), without changing the state.
 
     Returns float64[n, 2] wrapped into the periodic box.
     """
-    n = position.shape[0]
+    n = disks.shape[0]
     out = np.empty((n, 2))
     for i in range(n):
-        dt = t - t_disk[i]
-        out[i, 0] = wrap(position[i, 0] + velocity[i, 0] * dt, geometry[0], grid[2] != 0)
-        out[i, 1] = wrap(position[i, 1] + velocity[i, 1] * dt, geometry[1], grid[3] != 0)
+        dt = t - disks[i, T_OWN]
+        out[i, 0] = wrap(disks[i, X] + disks[i, VX] * dt, geometry[0], grid[2] != 0)
+        out[i, 1] = wrap(disks[i, Y] + disks[i, VY] * dt, geometry[1], grid[3] != 0)
     return out
 
 
 @njit(cache=True)
-def kinetic_energy_by_species(velocity, mass, species, n_species):
+def kinetic_energy_by_species(disks, mass, species, n_species):
     """Σ m v²/2 per species: float64[n_species]."""
     energy = np.zeros(n_species)
-    for i in range(velocity.shape[0]):
-        energy[species[i]] += 0.5 * mass[i] * (velocity[i, 0] ** 2 + velocity[i, 1] ** 2)
+    for i in range(disks.shape[0]):
+        energy[species[i]] += 0.5 * mass[i] * (disks[i, VX] ** 2 + disks[i, VY] ** 2)
     return energy

@@ -8,6 +8,10 @@ large numbers, and it is never negative, so no event is ever predicted in the pa
 
 Units: lengths in box units, times in the scene's time unit; all functions take float64
 scalars and return float64 scalars (``inf`` when there is no contact).
+
+The per-disk state the event loop reads for every neighbour lives in one row of
+``disks: float64[n, DISK_COLUMNS]`` (array of structs): predicting disk i touches one 64-byte
+cache line per neighbour instead of one line in each of four arrays.
 """
 
 import math
@@ -18,6 +22,17 @@ INF = math.inf
 #: Squared speeds below this (deep in the subnormal range of float64 once multiplied by a
 #: length) count as rest: a disk that slow never reaches its shell.
 TINY_SPEED_SQUARED = 1e-280
+
+# columns of the disk table ``disks: float64[n, DISK_COLUMNS]``
+X = 0  # position at the disk's own time (x, y)
+Y = 1
+VX = 2  # velocity (vx, vy)
+VY = 3
+T_OWN = 4  # the disk's own time (relative clock), at which (x, y) holds
+RADIUS = 5
+CX = 6  # centre of its neighbour shell (x, y)
+CY = 7
+DISK_COLUMNS = 8
 
 
 @njit(cache=True, inline="always")
@@ -50,7 +65,7 @@ def wrap(x, length, periodic):
     return x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def pair_contact_time(rx, ry, vx, vy, sigma):
     """Time until two disks at separation ``r = r_i - r_j`` with relative velocity
     ``v = v_i - v_j`` reach contact distance ``sigma``.
@@ -61,23 +76,21 @@ def pair_contact_time(rx, ry, vx, vy, sigma):
     the large |r|²|v|² from itself, so grazing contacts far away keep their precision.
     Disks already overlapping by round-off while approaching (c < 0, b < 0) collide at
     once: τ = 0 rather than a negative time, so they never tunnel through each other.
+
+    Branch-free: the root is always computed and discarded (→ inf) when the disks recede
+    (b ≥ 0) or miss (D ≤ 0). Whether a pair approaches is a coin flip to the branch
+    predictor, and the neighbour loop runs much faster without the mispredictions.
     """
     b = rx * vx + ry * vy
-    if b >= 0.0:
-        return INF
+    c = rx * rx + ry * ry - sigma * sigma
     a = vx * vx + vy * vy
     cross = rx * vy - ry * vx
     discriminant = a * sigma * sigma - cross * cross
-    if discriminant <= 0.0:
-        return INF
-    c = rx * rx + ry * ry - sigma * sigma
-    tau = c / (-b + math.sqrt(discriminant))
-    if tau < 0.0:
-        return 0.0
-    return tau
+    tau = max(c / (-b + math.sqrt(max(discriminant, 0.0))), 0.0)
+    return tau if (b < 0.0) & (discriminant > 0.0) else INF
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def shell_exit_time(dx, dy, vx, vy, delta):
     """Time until a disk at displacement ``d`` from its shell centre, moving with ``v``, is at
     distance ``delta`` from that centre: the larger root of |d + v τ|² = δ².
@@ -85,6 +98,9 @@ def shell_exit_time(dx, dy, vx, vy, delta):
     With b = d·v, c = |d|² - δ² ≤ 0 the roots have opposite signs; the positive one is
     (-b + s)/a for b ≤ 0 and -c/(b + s) for b > 0, s = sqrt(b² - a c). A disk found outside
     its shell by round-off (c > 0) leaves at once (τ = 0).
+
+    Both root forms are computed and one is selected, without a branch on the sign of b,
+    which the branch predictor cannot guess.
     """
     a = vx * vx + vy * vy
     if a < TINY_SPEED_SQUARED:
@@ -94,9 +110,9 @@ def shell_exit_time(dx, dy, vx, vy, delta):
         return 0.0
     b = dx * vx + dy * vy
     s = math.sqrt(b * b - a * c)
-    if b <= 0.0:
-        return (s - b) / a
-    return -c / (b + s)
+    moving_in = (s - b) / a
+    moving_out = -c / (b + s)
+    return moving_in if b <= 0.0 else moving_out
 
 
 @njit(cache=True, inline="always")

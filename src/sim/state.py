@@ -5,36 +5,44 @@ in space are close in memory — and remembers each one's original index in ``or
 user sees the original order only (:class:`sim.engine.Engine` translates).
 
 Per-disk arrays (n disks, engine order):
-  position, velocity float64[n, 2] at each disk's own time t_disk float64[n];
-  center float64[n, 2], delta float64[n] — neighbour shell (sim.neighbours);
-  radius, mass float64[n]; species int32[n]; is_big bool[n];
+  table float64[n, DISK_COLUMNS] — one 64-byte row per disk: position and velocity, the
+      disk's own time, radius, shell centre (columns in :mod:`sim.kinematics`);
+  delta float64[n] — neighbour-shell radius; mass float64[n]; species int32[n]; is_big bool[n];
   coll_count int64[n] — contacts (disk and wall) of each disk, also the staleness counter;
-  t_last float64[n], streak int32[n] — time of last contact and collapse streak;
+  t_last float64[n], streak int32[n] — time of the last contact, collapse streak;
   event_time float64[n], event_partner int32[n], event_count int64[n] — scheduled event;
-  slot int32[n] — position in the event queue;
+  links int32[n, 3] — place in the event queue (:mod:`sim.event_queue`);
   nb_start int64[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
-  cell_next, cell_prev, cell_of int32[n] — cell lists.
-Arrays holding disk ids: nb, heap, big, cell_head (and cell_next/cell_prev, event_partner ≥ 0).
+  cell_next, cell_prev, cell_of int32[n] — cell lists; order int64[n] — original index.
+Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
+calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells].
 """
 
 from dataclasses import dataclass, fields
 
 import numpy as np
 
-PER_DISK = ("position", "velocity", "t_disk", "center", "delta", "radius", "mass", "species",
-            "is_big", "coll_count", "t_last", "streak", "event_time", "event_partner",
-            "event_count", "slot", "nb_start", "nb_cap", "nb_count", "cell_next", "cell_prev",
-            "cell_of", "order")
+from sim.event_queue import NEXT, PREV
+from sim.kinematics import DISK_COLUMNS
+
+PER_DISK = ("table", "delta", "mass", "species", "is_big", "coll_count", "t_last", "streak",
+            "event_time", "event_partner", "event_count", "links", "nb_start", "nb_cap",
+            "nb_count", "cell_next", "cell_prev", "cell_of", "order")
+
+
+def disk_table(n):
+    """Zeroed float64[n, DISK_COLUMNS] whose rows start on 64-byte boundaries, so that each
+    row is one cache line."""
+    itemsize = np.dtype(np.float64).itemsize
+    raw = np.zeros(n * DISK_COLUMNS + 64 // itemsize)
+    first = (-raw.ctypes.data % 64) // itemsize
+    return raw[first:first + n * DISK_COLUMNS].reshape(n, DISK_COLUMNS)
 
 
 @dataclass
 class DiskArrays:
-    position: np.ndarray
-    velocity: np.ndarray
-    t_disk: np.ndarray
-    center: np.ndarray
+    table: np.ndarray
     delta: np.ndarray
-    radius: np.ndarray
     mass: np.ndarray
     species: np.ndarray
     is_big: np.ndarray
@@ -44,7 +52,7 @@ class DiskArrays:
     event_time: np.ndarray
     event_partner: np.ndarray
     event_count: np.ndarray
-    slot: np.ndarray
+    links: np.ndarray
     nb_start: np.ndarray
     nb_cap: np.ndarray
     nb_count: np.ndarray
@@ -54,6 +62,9 @@ class DiskArrays:
     order: np.ndarray
     nb: np.ndarray
     heap: np.ndarray
+    list_head: np.ndarray
+    calendar: np.ndarray
+    block_rate: np.ndarray
     big: np.ndarray
     cell_head: np.ndarray
 
@@ -61,21 +72,31 @@ class DiskArrays:
     def nbytes(self):
         return sum(getattr(self, f.name).nbytes for f in fields(self))
 
+    @property
+    def queue(self):
+        """The event-queue arrays in the order the compiled functions take them."""
+        return self.heap, self.links, self.list_head, self.calendar, self.block_rate
+
     def permute(self, perm):
         """Renumber the disks: new disk k is old disk ``perm[k]``. Every id is remapped and
         the neighbour lists are laid out anew in the new order; the physics is untouched."""
         new_id = np.empty_like(perm)
         new_id[perm] = np.arange(perm.size)
+
+        def remap(ids):
+            ids[ids >= 0] = new_id[ids[ids >= 0]].astype(ids.dtype)
+
         old_start, old_count = self.nb_start, self.nb_count
         for name in PER_DISK:
-            setattr(self, name, np.ascontiguousarray(getattr(self, name)[perm]))
-        partner = self.event_partner
-        partner[partner >= 0] = new_id[partner[partner >= 0]].astype(partner.dtype)
-        for name in ("cell_next", "cell_prev"):
-            links = getattr(self, name)
-            links[links >= 0] = new_id[links[links >= 0]].astype(links.dtype)
-        head = self.cell_head
-        head[head >= 0] = new_id[head[head >= 0]].astype(head.dtype)
+            if name == "table":
+                table = disk_table(perm.size)
+                table[:] = self.table[perm]
+                self.table = table
+            else:
+                setattr(self, name, np.ascontiguousarray(getattr(self, name)[perm]))
+        for ids in (self.event_partner, self.cell_next, self.cell_prev, self.cell_head,
+                    self.list_head, self.links[:, NEXT], self.links[:, PREV]):
+            remap(ids)
         self.heap = new_id[self.heap].astype(self.heap.dtype)
         self.big = np.sort(new_id[self.big]).astype(self.big.dtype)
         # neighbour lists: the same contents, ids remapped, one segment per disk in new order

@@ -1,0 +1,238 @@
+"""The typed configuration of a scene: dataclasses registered in Hydra's ConfigStore, and
+the range checks that types cannot express.
+
+Hydra rejects unknown keys and wrong types when it composes the config; :func:`validate`
+then checks every value against what is allowed and raises :class:`ConfigError` naming the
+key, the value and the allowed range. ``conf/config.yaml`` holds the defaults with a comment
+on every key; ``conf/scenario/*.yaml`` are the scenes.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+from hydra.core.config_store import ConfigStore
+from omegaconf import MISSING, DictConfig, OmegaConf
+
+from sim.initial import RSA_JAMMING
+
+SCENES = ("single_disk", "two_disks", "scattering", "gas", "mixture", "crater", "cooling")
+
+
+class ConfigError(ValueError):
+    """A config value outside what is allowed."""
+
+    def __init__(self, key, value, allowed):
+        self.key, self.value, self.allowed = key, value, allowed
+        super().__init__(f"{key}={value!r} is not allowed: {allowed}")
+
+
+@dataclass
+class BoxConfig:
+    size: list = field(default_factory=lambda: [1.0, 1.0])
+    boundary: str = "walls"
+
+
+@dataclass
+class DisksConfig:
+    n: int = 2000
+    radius: Optional[float] = None
+    packing_fraction: Optional[float] = None
+    mass: float = 1.0
+    speed: Optional[float] = 1.0
+    temperature: Optional[float] = None
+    placement: str = "auto"
+    zero_momentum: bool = False
+
+
+@dataclass
+class RestitutionConfig:
+    disk: float = 1.0
+    wall: float = 1.0
+
+
+@dataclass
+class TCConfig:
+    time: Optional[float] = None
+
+
+@dataclass
+class StopConfig:
+    collisions: Optional[int] = None
+    events: Optional[int] = None
+    time: Optional[float] = None
+    energy_fraction: Optional[float] = None
+    wall_seconds: Optional[float] = None
+
+
+@dataclass
+class OutputConfig:
+    every_collisions: Optional[int] = None
+    every_time: Optional[float] = None
+    file: str = "run.h5"
+    progress: bool = True
+
+
+@dataclass
+class ProjectileConfig:
+    radius: float = 0.05
+    speed: float = 10.0
+    mass: Optional[float] = None
+    position: list = field(default_factory=lambda: [0.5, 0.75])
+
+
+@dataclass
+class BedConfig:
+    n: int = 4000
+    radius: float = 0.0045
+    mass: float = 1.0
+    height: float = 0.5
+
+
+@dataclass
+class MixtureConfig:
+    masses: list = field(default_factory=lambda: [1.0, 4.0])
+    fractions: list = field(default_factory=lambda: [0.5, 0.5])
+
+
+@dataclass
+class ScatteringConfig:
+    impact_parameter: float = 0.0
+    target_radius: float = 0.1
+    target_mass: float = 1.0e6
+
+
+@dataclass
+class TwoDisksConfig:
+    positions: list = field(default_factory=lambda: [[0.25, 0.5], [0.75, 0.52]])
+    velocities: list = field(default_factory=lambda: [[1.0, 0.3], [-0.5, 0.8]])
+
+
+@dataclass
+class SimConfig:
+    scene: str = MISSING
+    seed: int = 0
+    box: BoxConfig = field(default_factory=BoxConfig)
+    disks: DisksConfig = field(default_factory=DisksConfig)
+    restitution: RestitutionConfig = field(default_factory=RestitutionConfig)
+    tc: TCConfig = field(default_factory=TCConfig)
+    stop: StopConfig = field(default_factory=StopConfig)
+    output: OutputConfig = field(default_factory=OutputConfig)
+    projectile: Optional[ProjectileConfig] = None
+    bed: Optional[BedConfig] = None
+    mixture: Optional[MixtureConfig] = None
+    scattering: Optional[ScatteringConfig] = None
+    two_disks: Optional[TwoDisksConfig] = None
+    resume: Optional[str] = None
+
+
+def register():
+    """Put the schema in Hydra's ConfigStore as ``sim_schema`` (conf/config.yaml extends it)."""
+    ConfigStore.instance().store(name="sim_schema", node=SimConfig)
+
+
+def _positive(cfg, key, value, allow_none=True, zero=False):
+    if value is None:
+        if allow_none:
+            return
+        raise ConfigError(key, value, "a number is required")
+    if not (value > 0 or (zero and value == 0)):
+        raise ConfigError(key, value, "must be ≥ 0" if zero else "must be > 0")
+
+
+def _within(key, value, low, high, text):
+    if value is not None and not low <= value <= high:
+        raise ConfigError(key, value, text)
+
+
+def validate(cfg: Any) -> None:
+    """Check every value of a composed config; raise :class:`ConfigError` on the first bad one."""
+    c = cfg if isinstance(cfg, DictConfig) else OmegaConf.structured(cfg)
+    if c.scene not in SCENES:
+        raise ConfigError("scene", c.scene, f"one of {', '.join(SCENES)}")
+    if len(c.box.size) != 2 or any(not (s > 0) for s in c.box.size):
+        raise ConfigError("box.size", list(c.box.size), "two positive side lengths [Lx, Ly]")
+    if c.box.boundary not in ("walls", "periodic"):
+        raise ConfigError("box.boundary", c.box.boundary, "walls or periodic")
+    d = c.disks
+    if d.n < 1:
+        raise ConfigError("disks.n", d.n, "at least 1 disk")
+    if d.radius is not None and d.packing_fraction is not None:
+        raise ConfigError("disks.radius", d.radius,
+                          "give disks.radius or disks.packing_fraction, not both")
+    _positive(c, "disks.radius", d.radius)
+    _within("disks.packing_fraction", d.packing_fraction, 1e-12, 0.9,
+            "between 0 and 0.9 (hexagonal close packing is 0.9069)")
+    _positive(c, "disks.mass", d.mass, allow_none=False)
+    if d.speed is not None and d.temperature is not None:
+        raise ConfigError("disks.speed", d.speed,
+                          "give disks.speed or disks.temperature (set the other to null)")
+    _positive(c, "disks.speed", d.speed, zero=True)
+    _positive(c, "disks.temperature", d.temperature, zero=True)
+    if d.placement not in ("random", "lattice", "auto"):
+        raise ConfigError("disks.placement", d.placement, "random, lattice or auto")
+    if d.placement == "random" and c.scene in ("gas", "mixture", "cooling"):
+        area = float(c.box.size[0]) * float(c.box.size[1])
+        phi = (d.packing_fraction if d.radius is None
+               else d.n * math.pi * d.radius**2 / area)
+        if phi is not None and phi > RSA_JAMMING:
+            raise ConfigError("disks.packing_fraction", round(phi, 4),
+                              f"random placement reaches at most φ ≈ {RSA_JAMMING}; use "
+                              f"disks.placement=lattice or auto")
+    _within("restitution.disk", c.restitution.disk, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
+    _within("restitution.wall", c.restitution.wall, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
+    _positive(c, "tc.time", c.tc.time, zero=True)
+    s = c.stop
+    for key in ("collisions", "events", "time", "wall_seconds"):
+        _positive(c, f"stop.{key}", s[key])
+    _within("stop.energy_fraction", s.energy_fraction, 0.0, 1.0, "between 0 and 1")
+    if all(s[k] is None for k in ("collisions", "events", "time", "energy_fraction",
+                                  "wall_seconds")):
+        raise ConfigError("stop", None, "at least one of stop.collisions, stop.events, "
+                          "stop.time, stop.energy_fraction, stop.wall_seconds")
+    o = c.output
+    if o.every_collisions is not None and o.every_time is not None:
+        raise ConfigError("output.every_collisions", o.every_collisions,
+                          "give output.every_collisions or output.every_time, not both")
+    _positive(c, "output.every_collisions", o.every_collisions)
+    _positive(c, "output.every_time", o.every_time)
+    if c.scene == "crater":
+        p, b = c.projectile, c.bed
+        if p is None or b is None:
+            raise ConfigError("scene", c.scene, "the crater scene needs projectile and bed")
+        _positive(c, "projectile.radius", p.radius, allow_none=False)
+        _positive(c, "projectile.speed", p.speed, zero=True, allow_none=False)
+        _positive(c, "projectile.mass", p.mass)
+        _positive(c, "bed.radius", b.radius, allow_none=False)
+        _positive(c, "bed.mass", b.mass, allow_none=False)
+        if b.n < 1:
+            raise ConfigError("bed.n", b.n, "at least 1 disk")
+        lx, ly = c.box.size
+        x, y = p.position
+        if not (p.radius <= x <= lx - p.radius and p.radius <= y <= ly - p.radius):
+            raise ConfigError("projectile.position", list(p.position),
+                              f"inside the box, at least projectile.radius={p.radius} from "
+                              f"every wall")
+        if y - p.radius < b.height:
+            raise ConfigError("projectile.position", list(p.position),
+                              f"above the bed (bed.height={b.height}) by at least its radius")
+        _within("bed.height", b.height, 1e-12, ly, f"between 0 and the box height {ly}")
+    if c.scene == "mixture":
+        m = c.mixture
+        if m is None or len(m.masses) != len(m.fractions) or len(m.masses) < 1:
+            raise ConfigError("mixture.masses", None if m is None else list(m.masses),
+                              "one mass per entry of mixture.fractions")
+        if any(not (x > 0) for x in m.masses):
+            raise ConfigError("mixture.masses", list(m.masses), "positive masses")
+        if any(x < 0 for x in m.fractions) or abs(sum(m.fractions) - 1.0) > 1e-9:
+            raise ConfigError("mixture.fractions", list(m.fractions),
+                              "non-negative fractions that sum to 1")
+    if c.scene == "scattering":
+        sc = c.scattering
+        _positive(c, "scattering.target_radius", sc.target_radius, allow_none=False)
+        _positive(c, "scattering.target_mass", sc.target_mass, allow_none=False)
+        if d.radius is None:
+            raise ConfigError("disks.radius", None, "the scattering projectile needs a radius")
+        _within("scattering.impact_parameter", sc.impact_parameter, 0.0,
+                sc.target_radius + d.radius,
+                f"between 0 and the contact distance {sc.target_radius + d.radius}")

@@ -1,0 +1,174 @@
+"""The run file: H5MD 1.1 (de Buyl, Colberg & Höfling, Comput. Phys. Commun. 185, 1546 (2014)).
+
+Layout written by :class:`RunWriter`:
+  /h5md                       version [1, 1]; author, creator (sim and its version)
+  /particles/disks/box        dimension 2, boundary ["none"|"periodic"]×2, edges [Lx, Ly]
+  /particles/disks/position   step int64[T], time float64[T], value float64[T, N, 2]
+  /particles/disks/velocity   the same layout
+  /particles/disks/radius, mass, species   time-independent, [N]
+  /observables/<name>         step, time, value — kinetic_energy, kinetic_energy_by_species
+                              [T, S], collisions, wall_collisions, dissipated_energy,
+                              collision_virial
+  /parameters                 config (resolved YAML), seed, versions, git commit, stop reason
+  /checkpoint/{a,b}           the engine's full state at the last two snapshots, ``latest``
+                              naming the complete one (for resume)
+Datasets are chunked per snapshot, compressed and flushed after every snapshot, so a killed
+run leaves a file readable up to its last snapshot. ``step`` counts contacts (disk–disk and
+disk–wall).
+"""
+
+import math
+import time as wallclock
+
+import h5py
+import numpy as np
+
+import sim
+
+OBSERVABLES = {
+    "kinetic_energy": ("energy", "Σ m v²/2 over all disks"),
+    "kinetic_energy_by_species": ("energy", "Σ m v²/2 per species, [species]"),
+    "collisions": ("1", "cumulative disk–disk collisions"),
+    "wall_collisions": ("1", "cumulative disk–wall collisions"),
+    "dissipated_energy": ("energy", "cumulative kinetic energy lost in contacts"),
+    "collision_virial": ("length × momentum", "cumulative Σ r_ij·Δp_i over disk contacts"),
+}
+
+
+def _time_series(group, shape, dtype, unit, description):
+    """An H5MD time-dependent element: extensible step, time and value datasets."""
+    group.attrs["description"] = description
+    group.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(1024,))
+    time = group.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64,
+                                chunks=(1024,))
+    time.attrs["unit"] = "time"
+    chunk = (1, *shape) if shape else (1024,)
+    value = group.create_dataset("value", shape=(0, *shape), maxshape=(None, *shape),
+                                 dtype=dtype, chunks=chunk,
+                                 compression="gzip" if shape else None,
+                                 compression_opts=1 if shape else None)
+    value.attrs["unit"] = unit
+    return group
+
+
+def _append(group, step, time, value):
+    k = group["step"].shape[0]
+    for name, item in (("step", step), ("time", time), ("value", value)):
+        dataset = group[name]
+        dataset.resize(k + 1, axis=0)
+        dataset[k] = item
+
+
+class RunWriter:
+    """Creates the run file and appends one frame per :meth:`snapshot`."""
+
+    def __init__(self, path, engine, parameters, mode="w", checkpoint_seconds=30.0):
+        self.path = path
+        self.checkpoint_seconds = checkpoint_seconds
+        self._last_checkpoint = -math.inf
+        self.file = h5py.File(path, mode)
+        if mode == "w":
+            self._create(engine, parameters)
+
+    def _create(self, engine, parameters):
+        f = self.file
+        h5md = f.create_group("h5md")
+        h5md.attrs["version"] = np.array([1, 1])
+        f.create_group("h5md/author").attrs["name"] = "sim"
+        creator = f.create_group("h5md/creator")
+        creator.attrs["name"] = "sim"
+        creator.attrs["version"] = sim.__version__
+        disks = f.create_group("particles/disks")
+        box = disks.create_group("box")
+        box.attrs["dimension"] = 2
+        box.attrs["boundary"] = np.array(["periodic" if p else "none"
+                                          for p in engine.periodic], dtype="S8")
+        box.create_dataset("edges", data=engine.box).attrs["unit"] = "length"
+        n = engine.n
+        _time_series(disks.create_group("position"), (n, 2), np.float64, "length",
+                     "disk centres, wrapped into the box")
+        _time_series(disks.create_group("velocity"), (n, 2), np.float64, "length/time",
+                     "disk velocities")
+        disks.create_dataset("radius", data=engine.radius).attrs["unit"] = "length"
+        disks.create_dataset("mass", data=engine.mass).attrs["unit"] = "mass"
+        disks.create_dataset("species", data=engine.species).attrs["unit"] = "1"
+        observables = f.create_group("observables")
+        for name, (unit, description) in OBSERVABLES.items():
+            shape = (engine.n_species,) if name.endswith("by_species") else ()
+            dtype = np.int64 if name.endswith("collisions") else np.float64
+            _time_series(observables.create_group(name), shape, dtype, unit, description)
+        p = f.create_group("parameters")
+        for key, value in parameters.items():
+            p.attrs[key] = value
+        p.attrs["stop_reason"] = "running"
+        f.flush()
+
+    def snapshot(self, engine, time=None, checkpoint=False):
+        """Append the state at absolute ``time`` (default: the last event) and flush. The
+        engine state is checkpointed with it when ``checkpoint`` is set or when
+        ``checkpoint_seconds`` of wall time have passed since the last checkpoint."""
+        t = engine.time if time is None else float(time)
+        step = engine.events
+        disks = self.file["particles/disks"]
+        _append(disks["position"], step, t, engine.positions(t))
+        _append(disks["velocity"], step, t, engine.velocities())
+        obs = self.file["observables"]
+        values = {"kinetic_energy": engine.kinetic_energy(),
+                  "kinetic_energy_by_species": engine.kinetic_energy_by_species(),
+                  "collisions": engine.collisions, "wall_collisions": engine.wall_collisions,
+                  "dissipated_energy": engine.dissipated_energy,
+                  "collision_virial": engine.virial}
+        for name, value in values.items():
+            _append(obs[name], step, t, value)
+        if checkpoint or wallclock.monotonic() - self._last_checkpoint >= self.checkpoint_seconds:
+            self._checkpoint(engine, t)
+            self._last_checkpoint = wallclock.monotonic()
+        self.file.flush()
+
+    def _checkpoint(self, engine, t):
+        """Store the engine state in the older of two slots, then point ``latest`` at it:
+        a run killed while writing keeps the previous, complete checkpoint."""
+        root = self.file.require_group("checkpoint")
+        slot = "b" if root.attrs.get("latest", "b") == "a" else "a"
+        group = root.require_group(slot)
+        for key, value in engine.state_dict().items():
+            value = np.asarray(value)
+            if key in group and group[key].shape[1:] == value.shape[1:] and value.ndim:
+                dataset = group[key]
+                dataset.resize(value.shape[0], axis=0)
+                dataset[...] = value
+            else:
+                if key in group:
+                    del group[key]
+                group.create_dataset(key, data=value, maxshape=(None, *value.shape[1:])
+                                     if value.ndim else None)
+        group.attrs["time"] = t
+        group.attrs["snapshots"] = self.file["particles/disks/position/step"].shape[0]
+        self.file.flush()
+        root.attrs["latest"] = slot
+
+    def finish(self, reason):
+        self.file["parameters"].attrs["stop_reason"] = reason
+        self.file.flush()
+
+    def close(self):
+        if self.file.id.valid:
+            self.file.close()
+
+
+def read_checkpoint(file):
+    """The engine state of the latest complete checkpoint, its time and its snapshot count."""
+    root = file["checkpoint"]
+    group = root[root.attrs["latest"]]
+    state = {}
+    group.visititems(lambda name, item: state.__setitem__(name, item[()])
+                     if isinstance(item, h5py.Dataset) else None)
+    return state, float(group.attrs["time"]), int(group.attrs["snapshots"])
+
+
+def truncate(file, snapshots):
+    """Drop frames written after the first ``snapshots`` ones (before resuming)."""
+    for group in [file["particles/disks/position"], file["particles/disks/velocity"],
+                  *file["observables"].values()]:
+        for name in ("step", "time", "value"):
+            group[name].resize(snapshots, axis=0)

@@ -1,0 +1,85 @@
+"""``python -m sim.inspect PATH [--json]`` (also ``sim-inspect``): what a run file holds.
+
+Scene, number of disks, snapshots, time span, energy drift (or dissipation), collisions and
+the stop reason; ``--json`` prints the same as one JSON object for scripts. A file that is
+not a readable sim run file ends with one line on stderr and exit status 2.
+"""
+
+import argparse
+import json
+import sys
+
+import h5py
+import numpy as np
+import yaml
+
+
+class RunFileError(ValueError):
+    """Not a readable sim run file."""
+
+
+def summary(path):
+    """A dict describing the run file at ``path``."""
+    try:
+        f = h5py.File(path, "r")
+    except (OSError, ValueError) as error:
+        raise RunFileError(f"{path}: not a readable HDF5 file ({error})") from error
+    with f:
+        if "h5md" not in f or "particles/disks/position" not in f:
+            raise RunFileError(f"{path}: an HDF5 file, but not an H5MD run file of sim "
+                               f"(no /h5md or /particles/disks/position)")
+        try:
+            parameters = f["parameters"].attrs
+            config = yaml.safe_load(parameters["config"])
+            time = f["particles/disks/position/time"][()]
+            energy = f["observables/kinetic_energy/value"][()]
+            dissipated = f["observables/dissipated_energy/value"][()]
+            collisions = f["observables/collisions/value"][()]
+            n = f["particles/disks/radius"].shape[0]
+            creator = f["h5md/creator"].attrs
+            result = {
+                "path": str(path),
+                "scene": config.get("scene"),
+                "n": int(n),
+                "species": int(np.max(f["particles/disks/species"][()]) + 1),
+                "boundary": [b.decode() for b in f["particles/disks/box"].attrs["boundary"]],
+                "snapshots": int(time.size),
+                "time_span": [float(time[0]), float(time[-1])] if time.size else None,
+                "collisions": int(collisions[-1]) if collisions.size else 0,
+                "initial_energy": float(energy[0]) if energy.size else None,
+                "final_energy": float(energy[-1]) if energy.size else None,
+                "dissipated_energy": float(dissipated[-1]) if dissipated.size else 0.0,
+                "stop_reason": str(parameters["stop_reason"]),
+                "seed": int(parameters["seed"]),
+                "creator": f"{creator['name']} {creator['version']}",
+            }
+        except (KeyError, OSError, ValueError, yaml.YAMLError) as error:
+            raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
+    if energy.size:
+        # energy drift: E + dissipated should stay E0
+        balance = (energy + dissipated - energy[0]) / energy[0] if energy[0] else energy * 0
+        result["energy_drift"] = float(np.max(np.abs(balance)))
+    return result
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="sim-inspect", description=__doc__.splitlines()[0])
+    parser.add_argument("path", help="run file (run.h5)")
+    parser.add_argument("--json", action="store_true", help="one JSON object")
+    args = parser.parse_args(argv)
+    try:
+        info = summary(args.path)
+    except RunFileError as error:
+        print(f"sim-inspect: {error}", file=sys.stderr)
+        return 2
+    if args.json:
+        print(json.dumps(info))
+        return 0
+    width = max(len(k) for k in info)
+    for key, value in info.items():
+        print(f"{key:<{width}}  {value}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,144 @@
+"""The runner: a validated config becomes a run file.
+
+:func:`run` builds the scene and the engine (errors here are config errors, found before a
+file exists), then advances the engine in compiled chunks from snapshot to snapshot, writing
+each to the H5MD run file, until a stop condition holds. :func:`resume` continues a run file
+from its last checkpoint to the same bits as a run never interrupted.
+"""
+
+import math
+import subprocess
+import sys
+import time as wallclock
+from pathlib import Path
+
+import h5py
+import numpy as np
+from omegaconf import OmegaConf
+from tqdm import tqdm
+
+import sim
+from sim.config import ConfigError, SimConfig, validate
+from sim.engine import Engine
+from sim.h5md import RunWriter, read_checkpoint, truncate
+from sim.scenes import build_scene
+
+
+def _git_commit():
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
+                             capture_output=True, text=True, timeout=5, check=True)
+        return out.stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def parameters(cfg):
+    """What /parameters records: the resolved config, seed, versions, commit."""
+    import h5py as _h5py
+    import numba
+
+    return {"config": OmegaConf.to_yaml(cfg, resolve=True), "seed": int(cfg.seed),
+            "versions": f"sim {sim.__version__}, python {sys.version.split()[0]}, numpy "
+                        f"{np.__version__}, numba {numba.__version__}, h5py "
+                        f"{_h5py.__version__}",
+            "git_commit": _git_commit()}
+
+
+def build_engine(cfg):
+    """Scene and engine for a validated config; bad values raise :class:`ConfigError`."""
+    scene = build_scene(cfg)
+    restitution = float(cfg.restitution.disk)
+    try:
+        return Engine(scene.position, scene.velocity, scene.radius, scene.mass, scene.species,
+                      boundary=scene.boundary, restitution=restitution,
+                      wall_restitution=float(cfg.restitution.wall), tc=cfg.tc.time)
+    except ValueError as error:
+        raise ConfigError("scene", cfg.scene, str(error)) from error
+
+
+def _progress(cfg, engine):
+    total = cfg.stop.collisions
+    disable = not (cfg.output.progress and sys.stderr.isatty())
+    return tqdm(total=total, initial=engine.collisions, unit="coll", unit_scale=True,
+                disable=disable, dynamic_ncols=True)
+
+
+def advance(engine, cfg, writer, last_time):
+    """Run from snapshot to snapshot (the last one at ``last_time``) until a stop condition
+    holds; returns its name."""
+    stop, out = cfg.stop, cfg.output
+    started = wallclock.perf_counter()
+    bar = _progress(cfg, engine)
+    try:
+        while True:
+            next_collisions = (engine.collisions + out.every_collisions
+                               if out.every_collisions else None)
+            next_time = last_time + out.every_time if out.every_time else None
+            collisions = min(x for x in (stop.collisions, next_collisions, math.inf)
+                             if x is not None)
+            t_stop = min(x for x in (stop.time, next_time, math.inf) if x is not None)
+            budget = (None if stop.wall_seconds is None
+                      else max(stop.wall_seconds - (wallclock.perf_counter() - started), 0.0))
+            reason = engine.run(
+                events=stop.events, collisions=None if collisions == math.inf else collisions,
+                time=None if t_stop == math.inf else t_stop,
+                energy_fraction=stop.energy_fraction, wall_seconds=budget)
+            snapshot_time = t_stop if reason == "time" else None
+            if reason == "no_events" and t_stop < math.inf:
+                snapshot_time, reason = t_stop, "time"
+            last_time = engine.time if snapshot_time is None else snapshot_time
+            last = {"collisions": stop.collisions is not None
+                    and engine.collisions >= stop.collisions,
+                    "time": stop.time is not None and last_time >= stop.time,
+                    }.get(reason, True)
+            writer.snapshot(engine, snapshot_time, checkpoint=last)
+            bar.update(engine.collisions - bar.n)
+            bar.set_postfix(t=f"{last_time:.4g}", energy=f"{engine.kinetic_energy():.4g}")
+            if last:
+                return reason
+    finally:
+        bar.close()
+
+
+def run(cfg, output_dir="."):
+    """Run the scene of ``cfg`` into ``output_dir/cfg.output.file``; returns the path."""
+    if not OmegaConf.is_config(cfg):
+        cfg = OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
+    validate(cfg)
+    engine = build_engine(cfg)
+    path = Path(output_dir) / cfg.output.file
+    writer = RunWriter(path, engine, parameters(cfg))
+    try:
+        writer.snapshot(engine, 0.0)
+        reason = advance(engine, cfg, writer, 0.0)
+        writer.finish(reason)
+    except BaseException as error:
+        writer.finish(f"error: {type(error).__name__}: {error}")
+        raise
+    finally:
+        writer.close()
+    return path
+
+
+def resume(path):
+    """Continue the run file at ``path`` from its latest checkpoint, appending to it."""
+    path = Path(path)
+    with h5py.File(path, "r") as f:
+        config_yaml = f["parameters"].attrs["config"]
+    cfg = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(config_yaml))
+    validate(cfg)
+    engine = build_engine(cfg)
+    writer = RunWriter(path, engine, parameters(cfg), mode="r+")
+    try:
+        state, last_time, snapshots = read_checkpoint(writer.file)
+        engine.load_state_dict(state)
+        truncate(writer.file, snapshots)
+        reason = advance(engine, cfg, writer, last_time)
+        writer.finish(reason)
+    except BaseException as error:
+        writer.finish(f"error: {type(error).__name__}: {error}")
+        raise
+    finally:
+        writer.close()
+    return path

@@ -1,0 +1,174 @@
+"""Scenes: from a validated config to the initial state of the engine.
+
+Each scene is a function registered under its name (``@scene("crater")``) that returns a
+:class:`Scene`; adding a scene is adding a function here and a YAML file in
+``conf/scenario/``. Positions and velocities are float64[n, 2] in box units.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.config import ConfigError
+from sim.engine import Boundary
+from sim.initial import (
+    RSA_JAMMING,
+    PlacementError,
+    fixed_speed,
+    hexagonal_lattice,
+    maxwellian,
+    random_sequential,
+    remove_drift,
+)
+
+BUILDERS = {}
+
+
+@dataclass
+class Scene:
+    position: np.ndarray
+    velocity: np.ndarray
+    radius: np.ndarray
+    mass: np.ndarray
+    species: np.ndarray
+    boundary: Boundary
+
+
+def scene(name):
+    """Register a scene builder ``f(cfg, rng_seed) -> Scene`` under ``name``."""
+    def register(builder):
+        BUILDERS[name] = builder
+        return builder
+    return register
+
+
+def build_scene(cfg):
+    """The initial state of the scene named by ``cfg.scene``."""
+    return BUILDERS[cfg.scene](cfg)
+
+
+def _boundary(cfg):
+    periodic = cfg.box.boundary == "periodic"
+    return Boundary(size=(float(cfg.box.size[0]), float(cfg.box.size[1])),
+                    periodic=(periodic, periodic))
+
+
+def _gas_radius(cfg):
+    d = cfg.disks
+    area = float(cfg.box.size[0]) * float(cfg.box.size[1])
+    if d.radius is not None:
+        return float(d.radius)
+    if d.packing_fraction is None:
+        raise ConfigError("disks.packing_fraction", None,
+                          "give disks.radius or disks.packing_fraction")
+    return float(np.sqrt(d.packing_fraction * area / (d.n * np.pi)))
+
+
+def _place(cfg, radius, n, region=None):
+    """Random placement, or the lattice when asked or (auto) when random cannot reach φ."""
+    box = (float(cfg.box.size[0]), float(cfg.box.size[1]))
+    boundary = _boundary(cfg)
+    placement = cfg.disks.placement
+    radii = np.full(n, radius)
+    if region is None:
+        area = box[0] * box[1]
+    else:
+        area = (region[0][1] - region[0][0]) * (region[1][1] - region[1][0])
+    phi = n * np.pi * radius**2 / area
+    if placement == "auto":
+        placement = "random" if phi < 0.8 * RSA_JAMMING else "lattice"
+    try:
+        if placement == "random":
+            return random_sequential(radii, box=box, region=region,
+                                     periodic=boundary.periodic, seed=cfg.seed)
+        return hexagonal_lattice(n, radius, box=box, region=region, periodic=boundary.periodic,
+                                 seed=cfg.seed)
+    except PlacementError as error:
+        raise ConfigError("disks.placement" if cfg.disks.placement != "auto" else
+                          "disks.packing_fraction", cfg.disks.placement
+                          if cfg.disks.placement != "auto" else round(phi, 4),
+                          str(error)) from error
+
+
+def _velocities(cfg, mass):
+    d = cfg.disks
+    if d.temperature is not None:
+        velocity = maxwellian(mass, d.temperature, seed=cfg.seed + 1)
+    else:
+        velocity = fixed_speed(mass.size, d.speed, seed=cfg.seed + 1)
+    return remove_drift(velocity, mass) if d.zero_momentum else velocity
+
+
+@scene("gas")
+def gas(cfg):
+    n = cfg.disks.n
+    radius = _gas_radius(cfg)
+    mass = np.full(n, float(cfg.disks.mass))
+    return Scene(_place(cfg, radius, n), _velocities(cfg, mass), np.full(n, radius), mass,
+                 np.zeros(n, np.int32), _boundary(cfg))
+
+
+scene("cooling")(gas)
+
+
+@scene("mixture")
+def mixture(cfg):
+    base = gas(cfg)
+    n = cfg.disks.n
+    counts = np.floor(np.asarray(cfg.mixture.fractions) * n).astype(int)
+    counts[0] += n - counts.sum()
+    species = np.repeat(np.arange(counts.size, dtype=np.int32), counts)
+    species = np.random.default_rng(cfg.seed + 2).permutation(species)
+    base.species = species
+    base.mass = np.asarray(cfg.mixture.masses, dtype=np.float64)[species]
+    base.velocity = _velocities(cfg, base.mass)
+    return base
+
+
+@scene("single_disk")
+def single_disk(cfg):
+    radius = _gas_radius(cfg)
+    ly = float(cfg.box.size[1])
+    speed = cfg.disks.speed if cfg.disks.speed is not None else 1.0
+    velocity = speed * np.array([[1.0, 1.0]]) / np.sqrt(2.0)
+    return Scene(np.array([[radius, 0.5 * ly]]), velocity, np.array([radius]),
+                 np.array([float(cfg.disks.mass)]), np.zeros(1, np.int32), _boundary(cfg))
+
+
+@scene("two_disks")
+def two_disks(cfg):
+    radius = _gas_radius(cfg)
+    return Scene(np.array(cfg.two_disks.positions, dtype=np.float64),
+                 np.array(cfg.two_disks.velocities, dtype=np.float64), np.full(2, radius),
+                 np.full(2, float(cfg.disks.mass)), np.zeros(2, np.int32), _boundary(cfg))
+
+
+@scene("scattering")
+def scattering(cfg):
+    s = cfg.scattering
+    lx, ly = (float(x) for x in cfg.box.size)
+    r = float(cfg.disks.radius)
+    target = [0.6 * lx, 0.5 * ly]
+    projectile = [r + 0.05 * lx, 0.5 * ly + float(s.impact_parameter)]
+    speed = cfg.disks.speed if cfg.disks.speed is not None else 1.0
+    return Scene(np.array([projectile, target]), np.array([[speed, 0.0], [0.0, 0.0]]),
+                 np.array([r, float(s.target_radius)]),
+                 np.array([float(cfg.disks.mass), float(s.target_mass)]),
+                 np.array([0, 1], np.int32), _boundary(cfg))
+
+
+@scene("crater")
+def crater(cfg):
+    p, b = cfg.projectile, cfg.bed
+    lx = float(cfg.box.size[0])
+    bed = _place(cfg, float(b.radius), int(b.n), region=((0.0, lx), (0.0, float(b.height))))
+    n = int(b.n) + 1
+    position = np.vstack([bed, [list(p.position)]])
+    velocity = np.zeros((n, 2))
+    velocity[-1] = [0.0, -float(p.speed)]
+    radius = np.append(np.full(n - 1, float(b.radius)), float(p.radius))
+    projectile_mass = (float(p.mass) if p.mass is not None
+                       else float(b.mass) * (float(p.radius) / float(b.radius)) ** 2)
+    mass = np.append(np.full(n - 1, float(b.mass)), projectile_mass)
+    species = np.append(np.zeros(n - 1, np.int32), 1).astype(np.int32)
+    return Scene(position, velocity, radius, mass, species, _boundary(cfg))

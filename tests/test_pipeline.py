@@ -1,0 +1,139 @@
+"""The pipeline: every scenario composes and runs, the run file has the H5MD layout, bad
+values exit with status 2 and write nothing, resume continues to the same bits, sweeps run."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from hydra import compose, initialize_config_dir
+
+from sim import runner
+from sim.__main__ import CONF_DIR
+from sim.config import ConfigError, register
+from sim.inspect import RunFileError, summary
+
+register()
+SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
+SHRINK = {"gas": ["disks.n=300"], "mixture": ["disks.n=300"], "cooling": ["disks.n=300"],
+          "crater": ["bed.n=400", "projectile.radius=0.02"]}
+
+
+def compose_scene(name, *overrides):
+    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+        return compose("config", overrides=[f"scenario={name}", *SHRINK.get(name, []),
+                                            "output.progress=false", *overrides])
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
+    cfg = compose_scene(name, "stop.collisions=300", "stop.events=1000",
+                        "output.every_collisions=null", "output.every_time=2.0")
+    path = runner.run(cfg, tmp_path)
+    with h5py.File(path, "r") as f:
+        assert list(f["h5md"].attrs["version"]) == [1, 1]
+        assert f["h5md/creator"].attrs["name"] == "sim"
+        box = f["particles/disks/box"]
+        assert box.attrs["dimension"] == 2 and box["edges"].shape == (2,)
+        n = f["particles/disks/radius"].shape[0]
+        for element in ("position", "velocity"):
+            g = f[f"particles/disks/{element}"]
+            frames = g["step"].shape[0]
+            assert frames >= 2 and g["time"].shape == (frames,)
+            assert g["value"].shape == (frames, n, 2)
+        for name_ in ("kinetic_energy", "kinetic_energy_by_species", "collisions",
+                      "wall_collisions", "dissipated_energy", "collision_virial"):
+            assert f[f"observables/{name_}/value"].shape[0] == frames
+        assert f["parameters"].attrs["stop_reason"] in ("collisions", "events", "time",
+                                                        "energy_fraction", "no_events")
+        assert "scene: " + name in f["parameters"].attrs["config"]
+        energy = f["observables/kinetic_energy/value"][()]
+        lost = f["observables/dissipated_energy/value"][()]
+        np.testing.assert_allclose(energy + lost, energy[0], rtol=1e-10)
+    info = summary(path)
+    assert info["n"] == n and info["snapshots"] == frames
+
+
+def test_resume_continues_to_the_same_bits(tmp_path, monkeypatch):
+    cfg = compose_scene("gas", "stop.collisions=6000", "output.every_collisions=1000",
+                        "restitution.disk=0.9", "tc.time=1e-7")
+    (tmp_path / "whole").mkdir()
+    whole = runner.run(cfg, tmp_path / "whole")
+
+    original = runner.RunWriter.snapshot
+    calls = {"n": 0}
+
+    def killed_at_the_fourth_snapshot(self, engine, time=None, checkpoint=False):
+        original(self, engine, time, checkpoint=True)
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+
+    (tmp_path / "cut").mkdir()
+    monkeypatch.setattr(runner.RunWriter, "snapshot", killed_at_the_fourth_snapshot)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run(cfg, tmp_path / "cut")
+    monkeypatch.setattr(runner.RunWriter, "snapshot", original)
+    cut = tmp_path / "cut" / "run.h5"
+    assert summary(cut)["snapshots"] == 4
+    runner.resume(cut)
+    with h5py.File(whole, "r") as a, h5py.File(cut, "r") as b:
+        for key in ("particles/disks/position/value", "particles/disks/velocity/value",
+                    "particles/disks/position/time", "observables/collisions/value",
+                    "observables/dissipated_energy/value"):
+            np.testing.assert_array_equal(a[key][()], b[key][()], err_msg=key)
+        assert b["parameters"].attrs["stop_reason"] == "collisions"
+
+
+def run_cli(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "sim", *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=600)
+
+
+@pytest.mark.parametrize("override", [
+    "restitution.disk=1.5",
+    "disks.nn=3",
+    "disks.n=abc",
+    "disks.radius=0.01",
+    "disks.placement=random disks.packing_fraction=0.7",
+    "scenario=crater projectile.radius=-0.01",
+    "scenario=gas projectile.radius=0.1",
+    "scenario=nope",
+])
+def test_bad_values_exit_2_with_one_line_and_no_file(override, tmp_path):
+    result = run_cli(*override.split(), f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("sim: ")
+    assert not list(tmp_path.rglob("*.h5"))
+
+
+def test_the_sweep_command_writes_two_run_files(tmp_path):
+    # the command of the README, shrunk by overrides placed before its -m
+    result = run_cli("scenario=crater", "projectile.radius=0.01,0.02", "bed.n=300",
+                     "stop.collisions=2000", f"hydra.sweep.dir={tmp_path}/sweep", "-m",
+                     cwd=tmp_path)
+    assert result.returncode == 0, result.stderr[-2000:]
+    files = sorted(tmp_path.rglob("run.h5"))
+    assert len(files) == 2
+    radii = sorted(float(h5py.File(f, "r")["particles/disks/radius"][-1]) for f in files)
+    assert radii == [0.01, 0.02]
+
+
+def test_inspect_rejects_foreign_and_truncated_files(tmp_path):
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = 1
+    with pytest.raises(RunFileError, match="not an H5MD run file"):
+        summary(foreign)
+    text = tmp_path / "text.h5"
+    text.write_text("hello")
+    with pytest.raises(RunFileError, match="not a readable HDF5"):
+        summary(text)
+
+
+def test_config_error_names_key_value_and_allowed():
+    error = ConfigError("restitution.disk", 1.5, "between 0 and 1")
+    assert str(error) == "restitution.disk=1.5 is not allowed: between 0 and 1"
