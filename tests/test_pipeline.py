@@ -8,6 +8,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+import yaml
 from hydra import compose, initialize_config_dir
 
 from sim import runner
@@ -120,6 +121,50 @@ def test_the_sweep_command_writes_two_run_files(tmp_path):
     assert len(files) == 2
     radii = sorted(float(h5py.File(f, "r")["particles/disks/radius"][-1]) for f in files)
     assert radii == [0.01, 0.02]
+
+
+def test_a_failing_job_is_reported_and_the_others_finish(tmp_path, monkeypatch):
+    import sim.scenes
+
+    def crater_that_fails_for_big_projectiles(cfg):
+        if cfg.projectile.radius > 0.015:
+            raise RuntimeError("this projectile breaks the scene")
+        return original(cfg)
+
+    original = sim.scenes.BUILDERS["crater"]
+    monkeypatch.setitem(sim.scenes.BUILDERS, "crater", crater_that_fails_for_big_projectiles)
+    from sim import __main__ as entry
+
+    monkeypatch.setattr(sys, "argv", [
+        "sim", "scenario=crater", "projectile.radius=0.01,0.02", "bed.n=300",
+        "stop.collisions=2000", "output.progress=false", f"hydra.sweep.dir={tmp_path}",
+        "hydra/launcher=basic", "-m"])
+    with pytest.raises(SystemExit) as exit_:
+        entry.main()
+    assert exit_.value.code == 1
+    summary_ = yaml.safe_load((tmp_path / "sweep_summary.yaml").read_text())
+    assert (summary_["completed"], summary_["failed"]) == (1, 1)
+    failed = [job for job in summary_["details"] if job["status"] == "FAILED"]
+    assert "this projectile breaks the scene" in failed[0]["error"]
+    assert (tmp_path / "0" / "run.h5").exists()
+
+
+@pytest.mark.parametrize("seconds", [5.0, 7.5])
+def test_a_killed_run_leaves_a_readable_file(seconds, tmp_path):
+    run = subprocess.Popen([sys.executable, "-m", "sim", "disks.n=3000",
+                            "stop.collisions=100000000", "output.every_collisions=3000",
+                            f"hydra.run.dir={tmp_path}"], cwd=tmp_path,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        run.wait(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        run.kill()  # SIGKILL: no clean-up code runs
+        run.wait()
+    info = summary(tmp_path / "run.h5")
+    assert info["snapshots"] >= 1 and info["stop_reason"] == "running"
+    with h5py.File(tmp_path / "run.h5", "r") as f:
+        frames = f["particles/disks/position/value"].shape[0]
+        assert f["particles/disks/position/value"][frames - 1].shape == (3000, 2)
 
 
 def test_inspect_rejects_foreign_and_truncated_files(tmp_path):

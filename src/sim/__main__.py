@@ -5,6 +5,7 @@ before any work starts: a bad key, type or value prints one line and exits with 
 """
 
 import itertools
+import logging
 import sys
 from pathlib import Path
 
@@ -12,9 +13,11 @@ import hydra
 from hydra import compose, initialize_config_dir
 from hydra.core.hydra_config import HydraConfig
 from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.types import RunMode
 from omegaconf import OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
+from sim import callbacks
 from sim.config import ConfigError, register, validate
 
 CONF_DIR = str((Path(__file__).resolve().parents[2] / "conf"))
@@ -101,13 +104,21 @@ def hydra_main(cfg):
     from sim.inspect import summary
     from sim.runner import resume, run
 
+    sweeping = HydraConfig.get().mode == RunMode.MULTIRUN
     try:
         if cfg.resume is not None:
             path = resume(cfg.resume)
         else:
             path = run(cfg, HydraConfig.get().runtime.output_dir)
     except ConfigError as error:
-        _fail(str(error))
+        if not sweeping:
+            _fail(str(error))
+        return {"failed": f"ConfigError: {error}"}
+    except Exception as error:
+        if not sweeping:
+            raise
+        logging.getLogger(__name__).exception("job failed")
+        return {"failed": f"{type(error).__name__}: {error}"}
     info = summary(path)
     print(f"{info['scene']}: {info['n']} disks, {info['collisions']} collisions to t = "
           f"{info['time_span'][1]:.6g}, {info['snapshots']} snapshots, energy "
@@ -120,6 +131,8 @@ def hydra_main(cfg):
 def main():
     check_command_line(sys.argv[1:])
     hydra_main()
+    if callbacks.FAILED_JOBS:
+        sys.exit(1)
 
 
 if __name__ == "__main__":

@@ -26,6 +26,9 @@ class ConfigError(ValueError):
         self.key, self.value, self.allowed = key, value, allowed
         super().__init__(f"{key}={value!r} is not allowed: {allowed}")
 
+    def __reduce__(self):  # survives the trip back from a sweep's worker process
+        return type(self), (self.key, self.value, self.allowed)
+
 
 @dataclass
 class BoxConfig:
@@ -217,6 +220,11 @@ def validate(cfg: Any) -> None:
             raise ConfigError("projectile.position", list(p.position),
                               f"above the bed (bed.height={b.height}) by at least its radius")
         _within("bed.height", b.height, 1e-12, ly, f"between 0 and the box height {ly}")
+        bed_phi = b.n * math.pi * b.radius**2 / (lx * b.height)
+        if bed_phi > 0.85:
+            raise ConfigError("bed.n", b.n, f"at most a packing fraction of 0.85 in the bed "
+                              f"region (this is {bed_phi:.3f}): fewer or smaller bed disks, or "
+                              f"a higher bed.height")
     if c.scene == "mixture":
         m = c.mixture
         if m is None or len(m.masses) != len(m.fractions) or len(m.masses) < 1:

@@ -64,8 +64,9 @@ def _gas_radius(cfg):
     return float(np.sqrt(d.packing_fraction * area / (d.n * np.pi)))
 
 
-def _place(cfg, radius, n, region=None):
-    """Random placement, or the lattice when asked or (auto) when random cannot reach φ."""
+def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):
+    """Random placement, or the lattice when asked or (auto) when random cannot reach φ;
+    a packing that cannot be placed is a :class:`ConfigError` on ``key``."""
     box = (float(cfg.box.size[0]), float(cfg.box.size[1]))
     boundary = _boundary(cfg)
     placement = cfg.disks.placement
@@ -84,9 +85,7 @@ def _place(cfg, radius, n, region=None):
         return hexagonal_lattice(n, radius, box=box, region=region, periodic=boundary.periodic,
                                  seed=cfg.seed)
     except PlacementError as error:
-        raise ConfigError("disks.placement" if cfg.disks.placement != "auto" else
-                          "disks.packing_fraction", cfg.disks.placement
-                          if cfg.disks.placement != "auto" else round(phi, 4),
+        raise ConfigError(key, round(phi, 4) if key.endswith("fraction") else n,
                           str(error)) from error
 
 
@@ -161,7 +160,8 @@ def scattering(cfg):
 def crater(cfg):
     p, b = cfg.projectile, cfg.bed
     lx = float(cfg.box.size[0])
-    bed = _place(cfg, float(b.radius), int(b.n), region=((0.0, lx), (0.0, float(b.height))))
+    bed = _place(cfg, float(b.radius), int(b.n), region=((0.0, lx), (0.0, float(b.height))),
+                 key="bed.n")
     n = int(b.n) + 1
     position = np.vstack([bed, [list(p.position)]])
     velocity = np.zeros((n, 2))
