@@ -13,6 +13,7 @@ import yaml
 from hydra.core.hydra_config import HydraConfig
 from hydra.core.utils import JobStatus
 from hydra.experimental.callback import Callback
+from hydra.types import RunMode
 
 STATUS_FILE = "job_status.yaml"
 SUMMARY_FILE = "sweep_summary.yaml"
@@ -22,6 +23,8 @@ FAILED_JOBS = []
 
 class SweepReport(Callback):
     def on_job_end(self, config, job_return, **kwargs):
+        if HydraConfig.get().mode != RunMode.MULTIRUN:
+            return
         runtime = HydraConfig.get().runtime
         entry = {"job": HydraConfig.get().job.num,
                  "overrides": list(HydraConfig.get().overrides.task),

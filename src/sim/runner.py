@@ -24,6 +24,10 @@ from sim.h5md import RunWriter, read_checkpoint, truncate
 from sim.scenes import build_scene
 
 
+#: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
+FINISHED = ("collisions", "events", "time", "energy_fraction", "no_events")
+
+
 def _git_commit():
     try:
         out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
@@ -126,6 +130,9 @@ def resume(path):
     path = Path(path)
     with h5py.File(path, "r") as f:
         config_yaml = f["parameters"].attrs["config"]
+        reason = str(f["parameters"].attrs["stop_reason"])
+    if reason in FINISHED:
+        return path  # nothing left to do: the run ended by one of its stop conditions
     cfg = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(config_yaml))
     validate(cfg)
     engine = build_engine(cfg)
