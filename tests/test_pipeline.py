@@ -13,6 +13,7 @@ from hydra import compose, initialize_config_dir
 
 from sim import runner
 from sim.__main__ import CONF_DIR
+from sim.analysis import open_run, open_sweep
 from sim.config import ConfigError, register
 from sim.inspect import RunFileError, summary
 
@@ -121,6 +122,26 @@ def test_the_sweep_command_writes_two_run_files(tmp_path):
     assert len(files) == 2
     radii = sorted(float(h5py.File(f, "r")["particles/disks/radius"][-1]) for f in files)
     assert radii == [0.01, 0.02]
+    sweep = open_sweep(tmp_path / "sweep")
+    assert sweep["projectile_radius"].values.tolist() == [0.01, 0.02]
+    assert sweep["position"].dims == ("projectile_radius", "snapshot", "disk", "axis")
+    np.testing.assert_array_equal(sweep["radius"].isel(disk=-1), [0.01, 0.02])
+    assert (sweep["collisions"].max("snapshot") > 0).all()
+
+
+def test_open_run_is_lazy_and_labelled(tmp_path):
+    path = runner.run(compose_scene("mixture", "stop.collisions=3000",
+                                    "output.every_collisions=500"), tmp_path)
+    with open_run(path) as ds:
+        assert ds.attrs["scene"] == "mixture"
+        assert dict(ds.sizes) == {"time": 7, "disk": 300, "axis": 2, "species": 2}
+        assert not ds["position"].variable._in_memory
+        first = ds["position"].isel(time=0).values
+        with h5py.File(path, "r") as f:
+            np.testing.assert_array_equal(first, f["particles/disks/position/value"][0])
+        by_species = ds["kinetic_energy_by_species"].sum("species")
+        np.testing.assert_allclose(by_species, ds["kinetic_energy"], rtol=1e-12)
+        assert set(np.unique(ds["mass"].values)) == {1.0, 4.0}
 
 
 def test_a_failing_job_is_reported_and_the_others_finish(tmp_path, monkeypatch):

@@ -23,7 +23,6 @@ from sim.engine import Engine
 from sim.h5md import RunWriter, read_checkpoint, truncate
 from sim.scenes import build_scene
 
-
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
 FINISHED = ("collisions", "events", "time", "energy_fraction", "no_events")
 

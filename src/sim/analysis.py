@@ -1,0 +1,132 @@
+"""Run files as labelled arrays: :func:`open_run` and :func:`open_sweep` return xarray
+Datasets that the figure stages read; nothing here simulates.
+
+``open_run(path)``: dims ``time`` (one entry per snapshot, coordinate the snapshot time),
+``disk``, ``axis`` (x, y) and ``species``; variables ``position`` and ``velocity``
+(time, disk, axis) — read lazily from the HDF5 file, so only what is indexed is loaded —
+and the observables (``kinetic_energy``, ``kinetic_energy_by_species``, ``collisions``,
+``wall_collisions``, ``dissipated_energy``, ``collision_virial``); per-disk coordinates
+``radius``, ``mass``, ``species_id``; attributes: scene, seed, the resolved config (YAML), stop
+reason, box edges and boundary.
+
+``open_sweep(multirun_dir)``: the runs of a Hydra sweep in one Dataset with each swept
+parameter as a dimension (``projectile.radius`` → ``projectile_radius``); runs are aligned by
+snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate.
+"""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import xarray as xr
+import yaml
+from xarray.backends import BackendArray
+from xarray.core import indexing
+
+OBSERVABLES = ("kinetic_energy", "kinetic_energy_by_species", "collisions", "wall_collisions",
+               "dissipated_energy", "collision_virial")
+
+
+class _H5Array(BackendArray):
+    """An h5py dataset as a lazily indexed xarray backend array."""
+
+    def __init__(self, dataset):
+        self.dataset = dataset
+        self.shape = dataset.shape
+        self.dtype = dataset.dtype
+
+    def __getitem__(self, key):
+        return indexing.explicit_indexing_adapter(key, self.shape, indexing.IndexingSupport.BASIC,
+                                                  self._read)
+
+    def _read(self, key):
+        return self.dataset[key]
+
+
+def _lazy(dataset, dims):
+    return xr.Variable(dims, indexing.LazilyIndexedArray(_H5Array(dataset)))
+
+
+def open_run(path):
+    """The run file at ``path`` as an :class:`xarray.Dataset` (see the module docstring).
+    Close it with ``ds.close()`` (or use it in a ``with`` block) to release the file."""
+    f = h5py.File(path, "r")
+    try:
+        disks = f["particles/disks"]
+        time = disks["position/time"][()]
+        n_species = f["observables/kinetic_energy_by_species/value"].shape[1]
+        data = {
+            "position": _lazy(disks["position/value"], ("time", "disk", "axis")),
+            "velocity": _lazy(disks["velocity/value"], ("time", "disk", "axis")),
+        }
+        for name in OBSERVABLES:
+            dims = ("time", "species") if name.endswith("by_species") else ("time",)
+            group = f[f"observables/{name}"]
+            data[name] = xr.Variable(dims, group["value"][()],
+                                     attrs={"unit": group["value"].attrs.get("unit", ""),
+                                            "description": group.attrs.get("description", "")})
+        parameters = f["parameters"].attrs
+        config = yaml.safe_load(parameters["config"])
+        box = disks["box"]
+        ds = xr.Dataset(
+            data,
+            coords={"time": time, "step": ("time", disks["position/step"][()]),
+                    "axis": ["x", "y"], "species": np.arange(n_species),
+                    "radius": ("disk", disks["radius"][()]), "mass": ("disk", disks["mass"][()]),
+                    "species_id": ("disk", disks["species"][()])},
+            attrs={"scene": config.get("scene", ""), "seed": int(parameters["seed"]),
+                   "config": str(parameters["config"]),
+                   "stop_reason": str(parameters["stop_reason"]),
+                   "box": box["edges"][()].tolist(),
+                   "boundary": [b.decode() for b in box.attrs["boundary"]],
+                   "path": str(path)})
+    except Exception:
+        f.close()
+        raise
+    ds.set_close(f.close)
+    return ds
+
+
+def _overrides(job_dir):
+    path = Path(job_dir, ".hydra", "overrides.yaml")
+    items = yaml.safe_load(path.read_text()) if path.exists() else []
+    return dict(item.split("=", 1) for item in items if "=" in item and
+                not item.startswith("hydra"))
+
+
+def _value(text):
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+
+
+def open_sweep(multirun_dir):
+    """The runs of a sweep directory in one Dataset, one dimension per swept parameter."""
+    runs = sorted(Path(multirun_dir).glob("*/run.h5"))
+    if not runs:
+        raise FileNotFoundError(f"no */run.h5 under {multirun_dir}")
+    overrides = [_overrides(run.parent) for run in runs]
+    keys = sorted({k for o in overrides for k in o})
+    swept = [k for k in keys if len({o.get(k) for o in overrides}) > 1]
+    datasets = []
+    for run, override in zip(runs, overrides, strict=True):
+        ds = open_run(run).load()
+        ds.close()
+        ds = ds.rename({"time": "snapshot"}).assign_coords(
+            snapshot=np.arange(ds.sizes["time"]), time=("snapshot", ds["time"].values))
+        datasets.append(ds.expand_dims({k.replace(".", "_"): [_value(override[k])]
+                                        for k in swept}))
+    if not swept:
+        return xr.concat(datasets, dim="run", join="outer", data_vars="all", coords="different",
+                         compat="equals")
+    combined = xr.combine_by_coords(datasets, join="outer", combine_attrs="drop_conflicts",
+                                    data_vars="all", coords="different", compat="no_conflicts")
+    for name in (k.replace(".", "_") for k in swept):
+        combined = combined.sortby(name)
+    combined.attrs["swept"] = [k.replace(".", "_") for k in swept]
+    combined.attrs["sweep_dir"] = str(multirun_dir)
+    return combined
+
+
+__all__ = ["open_run", "open_sweep"]
