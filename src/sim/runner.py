@@ -104,6 +104,18 @@ def advance(engine, cfg, writer, last_time):
         bar.close()
 
 
+def _record(writer, work):
+    """Run ``work()`` (which returns the stop reason) and record how the run ended — its
+    stop reason or its error — in the file, which is closed on every path."""
+    try:
+        writer.finish(work())
+    except BaseException as error:
+        writer.finish(f"error: {type(error).__name__}: {error}")
+        raise
+    finally:
+        writer.close()
+
+
 def run(cfg, output_dir="."):
     """Run the scene of ``cfg`` into ``output_dir/cfg.output.file``; returns the path."""
     if not OmegaConf.is_config(cfg):
@@ -112,15 +124,12 @@ def run(cfg, output_dir="."):
     engine = build_engine(cfg)
     path = Path(output_dir) / cfg.output.file
     writer = RunWriter(path, engine, parameters(cfg))
-    try:
+
+    def from_the_start():
         writer.snapshot(engine, 0.0)
-        reason = advance(engine, cfg, writer, 0.0)
-        writer.finish(reason)
-    except BaseException as error:
-        writer.finish(f"error: {type(error).__name__}: {error}")
-        raise
-    finally:
-        writer.close()
+        return advance(engine, cfg, writer, 0.0)
+
+    _record(writer, from_the_start)
     return path
 
 
@@ -136,15 +145,12 @@ def resume(path):
     validate(cfg)
     engine = build_engine(cfg)
     writer = RunWriter(path, engine, parameters(cfg), mode="r+")
-    try:
+
+    def from_the_checkpoint():
         state, last_time, snapshots = read_checkpoint(writer.file)
         engine.load_state_dict(state)
         truncate(writer.file, snapshots)
-        reason = advance(engine, cfg, writer, last_time)
-        writer.finish(reason)
-    except BaseException as error:
-        writer.finish(f"error: {type(error).__name__}: {error}")
-        raise
-    finally:
-        writer.close()
+        return advance(engine, cfg, writer, last_time)
+
+    _record(writer, from_the_checkpoint)
     return path
