@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: help venv run test validate bench lint clean
+.PHONY: help venv run test validate bench figures lint clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -25,6 +25,9 @@ test: $(STAMP)  ## quick tests (long physics runs are marked slow)
 
 validate: $(STAMP)  ## every test, slow physics runs included
 	$(PY) -m pytest -q -m ""
+
+figures: $(STAMP)  ## every figure into outputs/figures/ (QUICK=1: small versions)
+	$(PY) -m sim.figures $(if $(QUICK),--quick)
 
 bench: $(STAMP)  ## engine rate table (see benchmarks/engine_rate.py --help)
 	$(PY) benchmarks/engine_rate.py

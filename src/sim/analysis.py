@@ -129,4 +129,10 @@ def open_sweep(multirun_dir):
     return combined
 
 
-__all__ = ["open_run", "open_sweep"]
+def at_last_snapshot(sweep, name):
+    """``sweep[name]`` at each run's own last snapshot (runs of a sweep differ in length)."""
+    last = sweep["time"].notnull().sum("snapshot") - 1
+    return sweep[name].isel(snapshot=last)
+
+
+__all__ = ["at_last_snapshot", "open_run", "open_sweep"]

@@ -1,0 +1,61 @@
+"""Runs and sweeps for the figure stages, each made once per resolved config.
+
+A run lives in ``<root>/<label>-<hash>/run.h5``, the hash taken over its resolved config, so a
+changed config makes a new run and an unchanged one is reused if it finished. Sweeps run as one
+Hydra multirun (``python -m sim … -m``) into ``<root>/<label>-<hash>/``.
+"""
+
+import hashlib
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+from hydra import compose, initialize_config_dir
+from omegaconf import OmegaConf
+
+from sim.__main__ import CONF_DIR
+from sim.config import register
+from sim.runner import FINISHED, run
+
+register()
+
+
+def compose_config(overrides):
+    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+        return compose("config", overrides=list(overrides))
+
+
+def _finished(path):
+    try:
+        with h5py.File(path, "r") as f:
+            return str(f["parameters"].attrs["stop_reason"]) in FINISHED
+    except (OSError, KeyError):
+        return False
+
+
+def _digest(text):
+    return hashlib.sha1(text.encode()).hexdigest()[:10]
+
+
+def ensure_run(label, overrides, root):
+    """The run file of ``overrides`` under ``root``, simulated only if not there yet."""
+    cfg = compose_config([*overrides, "output.progress=false"])
+    folder = Path(root) / f"{label}-{_digest(OmegaConf.to_yaml(cfg, resolve=True))}"
+    path = folder / cfg.output.file
+    if not _finished(path):
+        folder.mkdir(parents=True, exist_ok=True)
+        run(cfg, folder)
+    return path
+
+
+def ensure_sweep(label, overrides, root):
+    """The directory of a Hydra multirun over ``overrides`` (with comma lists or range()),
+    run only if it has not completed before."""
+    key = " ".join(sorted(overrides))
+    folder = Path(root) / f"{label}-{_digest(key)}"
+    if not (folder / "sweep_summary.yaml").exists():
+        command = [sys.executable, "-m", "sim", *overrides, "output.progress=false",
+                   f"hydra.sweep.dir={folder}", "-m"]
+        subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    return folder

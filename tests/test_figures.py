@@ -1,0 +1,25 @@
+"""Figure stages on small runs: they write a PNG and the numbers behind it, and the numbers
+say what the figure claims."""
+
+import numpy as np
+
+from sim.figures.__main__ import main
+
+
+def test_quick_figures(tmp_path):
+    main(["--quick", "--out", str(tmp_path)])
+    out = tmp_path / "quick"
+    for name in ("fig01_single_disk", "fig03_scattering"):
+        assert (out / f"{name}.png").stat().st_size > 10_000
+    path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
+    x, y, energy = path[:, 2], path[:, 3], path[:, 4]
+    radius = 0.05
+    # every snapshot on the tilted rectangle |x − 1/2| + |y − 1/2| = 1/2 − R
+    np.testing.assert_allclose(np.abs(x - 0.5) + np.abs(y - 0.5), 0.5 - radius, atol=1e-9)
+    assert np.all(energy == energy[0])
+    scattering = np.loadtxt(out / "fig03_scattering.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(scattering[:, 2], scattering[:, 3], atol=1e-9)
+    # a second call finds its runs and makes none again
+    stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
+    main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])
+    assert {p: p.stat().st_mtime for p in out.rglob("run.h5")} == stamp
