@@ -9,7 +9,8 @@ from sim.figures.__main__ import main
 def test_quick_figures(tmp_path):
     main(["--quick", "--out", str(tmp_path)])
     out = tmp_path / "quick"
-    for name in ("fig01_single_disk", "fig03_scattering"):
+    for name in ("fig01_single_disk", "fig03_scattering", "fig04_gas_snapshot",
+                 "fig05_maxwell_boltzmann"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
     x, y, energy = path[:, 2], path[:, 3], path[:, 4]
@@ -19,6 +20,10 @@ def test_quick_figures(tmp_path):
     assert np.all(energy == energy[0])
     scattering = np.loadtxt(out / "fig03_scattering.csv", delimiter=",", skiprows=1)
     np.testing.assert_allclose(scattering[:, 2], scattering[:, 3], atol=1e-9)
+    mb = dict(line.split("=") for line in
+              (out / "fig05_maxwell_boltzmann.txt").read_text().split())
+    assert float(mb["ks_pvalue"]) > 1e-3
+    assert 0 < float(mb["equilibration_collisions"]) < 10 * 1000
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
     main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])
