@@ -2,6 +2,7 @@
 say what the figure claims."""
 
 import numpy as np
+import pytest
 
 from sim.figures.__main__ import main
 
@@ -10,7 +11,7 @@ def test_quick_figures(tmp_path):
     main(["--quick", "--out", str(tmp_path)])
     out = tmp_path / "quick"
     for name in ("fig01_single_disk", "fig03_scattering", "fig04_gas_snapshot",
-                 "fig05_maxwell_boltzmann"):
+                 "fig05_maxwell_boltzmann", "fig06_mixture", "fig07_mixture_cooling"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
     x, y, energy = path[:, 2], path[:, 3], path[:, 4]
@@ -24,6 +25,11 @@ def test_quick_figures(tmp_path):
               (out / "fig05_maxwell_boltzmann.txt").read_text().split())
     assert float(mb["ks_pvalue"]) > 1e-3
     assert 0 < float(mb["equilibration_collisions"]) < 10 * 1000
+    mixture = np.loadtxt(out / "fig06_mixture.csv", delimiter=",", skiprows=1)
+    assert np.all(mixture[:, 2] > 1e-3)  # both species Maxwellian at the common T
+    cooling = np.loadtxt(out / "fig07_mixture_cooling.csv", delimiter=",", skiprows=1)
+    assert cooling[0, 2] == pytest.approx(1.0, abs=0.15)  # ξ = 1: equipartition
+    assert np.all(np.diff(cooling[:, 2]) > 0)  # the ratio grows as ξ falls, as predicted
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
     main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])

@@ -129,10 +129,37 @@ def open_sweep(multirun_dir):
     return combined
 
 
+def granular_temperatures(position, velocity, mass, species, box, cells=8):
+    """Temperature of each species in the frame of the local flow: velocities minus the
+    mass-weighted mean velocity u of their cell on a ``cells`` × ``cells`` grid, then
+    T_s = ⟨m (v − u)² / 2⟩ over the disks of species s (2D, k_B = 1). A cooling gas grows
+    shear and clustering modes; their collective motion is flow, not temperature.
+
+    ``position``, ``velocity``: float64[T, N, 2]; ``mass``, ``species``: [N].
+    Returns float64[T, n_species].
+    """
+    position, velocity = np.asarray(position), np.asarray(velocity)
+    n_species = int(species.max()) + 1
+    ix = np.clip((position[..., 0] / box[0] * cells).astype(int), 0, cells - 1)
+    iy = np.clip((position[..., 1] / box[1] * cells).astype(int), 0, cells - 1)
+    cell = ix * cells + iy
+    out = np.empty((position.shape[0], n_species))
+    for t in range(position.shape[0]):
+        weight = np.bincount(cell[t], weights=mass, minlength=cells * cells)
+        flow = np.stack([np.bincount(cell[t], weights=mass * velocity[t, :, a],
+                                     minlength=cells * cells) for a in range(2)], axis=1)
+        flow /= np.maximum(weight, 1e-300)[:, None]
+        peculiar = velocity[t] - flow[cell[t]]
+        energy = 0.5 * mass * np.sum(peculiar**2, axis=1)
+        out[t] = np.bincount(species, weights=energy, minlength=n_species) / np.bincount(
+            species, minlength=n_species)
+    return out
+
+
 def at_last_snapshot(sweep, name):
     """``sweep[name]`` at each run's own last snapshot (runs of a sweep differ in length)."""
     last = sweep["time"].notnull().sum("snapshot") - 1
     return sweep[name].isel(snapshot=last)
 
 
-__all__ = ["at_last_snapshot", "open_run", "open_sweep"]
+__all__ = ["at_last_snapshot", "granular_temperatures", "open_run", "open_sweep"]
