@@ -10,7 +10,7 @@ from sim.figures.__main__ import main
 def test_quick_figures(tmp_path):
     main(["--quick", "--out", str(tmp_path)])
     out = tmp_path / "quick"
-    for name in ("fig01_single_disk", "fig03_scattering", "fig04_gas_snapshot",
+    for name in ("fig01_single_disk", "fig02_two_disks", "fig03_scattering", "fig04_gas_snapshot",
                  "fig05_maxwell_boltzmann", "fig06_mixture", "fig07_mixture_cooling"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
@@ -25,6 +25,11 @@ def test_quick_figures(tmp_path):
               (out / "fig05_maxwell_boltzmann.txt").read_text().split())
     assert float(mb["ks_pvalue"]) > 1e-3
     assert 0 < float(mb["equilibration_collisions"]) < 10 * 1000
+    two = dict(line.split("=") for line in (out / "fig02_two_disks.txt").read_text().split())
+    assert (out / "fig02_two_disks.gif").stat().st_size > 10_000
+    # the measured loss of order agrees with ln(R / 1e-12) / ln(growth per collision)
+    assert float(two["order_lost_after_collisions"]) == pytest.approx(
+        float(two["estimate_collisions"]), abs=3)
     mixture = np.loadtxt(out / "fig06_mixture.csv", delimiter=",", skiprows=1)
     assert np.all(mixture[:, 2] > 1e-3)  # both species Maxwellian at the common T
     cooling = np.loadtxt(out / "fig07_mixture_cooling.csv", delimiter=",", skiprows=1)

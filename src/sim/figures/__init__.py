@@ -7,5 +7,5 @@ A stage is a module here with ``NAME``, ``runs(quick) -> {label: [overrides]}`` 
 ``draw(runs, sweeps, out_dir)`` taking the run-file paths and sweep directories by label.
 """
 
-STAGES = ("single_disk", "scattering", "gas_snapshot", "maxwell_boltzmann", "mixture",
+STAGES = ("single_disk", "two_disks", "scattering", "gas_snapshot", "maxwell_boltzmann", "mixture",
           "mixture_cooling")
