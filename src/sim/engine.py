@@ -209,10 +209,12 @@ class Engine:
         self.geometry = np.array([box[0], box[1], box[0] / cells[0], box[1] / cells[1], reach])
         self.grid = np.array([cells[0], cells[1], int(self.periodic[0]), int(self.periodic[1])],
                              dtype=np.int64)
-        # list capacity: twice the expected number of overlapping shells, plus a margin
-        expected = 4.0 * max(phi_small, 0.3) * (1.0 + delta_small / median) ** 2
+        # list capacity: the expected number of overlapping shells, 4 φ (1 + δ/R)², plus three
+        # standard deviations of its (at most Poisson) fluctuations and a margin; the rare
+        # list that overflows grows on demand
+        expected = 4.0 * phi_small * (1.0 + delta_small / median) ** 2
         if list_capacity is None:
-            list_capacity = int(4 * math.ceil((2.0 * expected + 8.0) / 4))
+            list_capacity = int(4 * math.ceil((expected + 3.0 * math.sqrt(expected) + 4.0) / 4))
         cap = np.full(n, max(int(list_capacity), 1), dtype=np.int32)
         if big.size:
             density = max(phi_small, 0.6) / (np.pi * median**2)
@@ -233,8 +235,8 @@ class Engine:
             event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int64),
             links=links, nb_start=nb_start, nb_cap=cap, nb_count=np.zeros(n, np.int32),
             cell_next=minus_one.copy(), cell_prev=minus_one.copy(), cell_of=minus_one.copy(),
-            order=np.arange(n), nb=np.full(int(cap.sum()), -1, dtype=np.int32), heap=heap,
-            list_head=list_head, calendar=calendar, block_rate=block_rate,
+            order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
+            heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
             big=big.astype(np.int32),
             cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32))
         self.packing_fraction = phi

@@ -86,6 +86,21 @@ def advance(i, t, disks, geometry, grid):
     disks[i, T_OWN] = t
 
 
+@njit(cache=True, _nrt=False, error_model="numpy")
+def hit_wall(i, wall, xi_wall, disks, mass, geometry):
+    """Disk i (at the time of contact) touches ``wall`` (0 … 3: 2 axis + side): clamp it
+    inside the box against round-off and reflect it. Returns (energy dissipated, momentum
+    given to the wall)."""
+    axis = wall >> 1
+    lo = disks[i, RADIUS]
+    hi = geometry[axis] - disks[i, RADIUS]
+    if disks[i, X + axis] < lo:
+        disks[i, X + axis] = lo
+    elif disks[i, X + axis] > hi:
+        disks[i, X + axis] = hi
+    return reflect_from_wall(i, axis, xi_wall, disks, mass)
+
+
 @njit(cache=True, inline="always")
 def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
             nb_count, nb, geometry, grid):
@@ -216,16 +231,12 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
             stalled = 0
             t_previous = t
         partner = event_partner[i]
-        if partner >= 0:
-            j = partner
-            if coll_count[j] != event_count[i]:
-                stale_events += 1
-                advance(i, t, disks, geometry, grid)
-                predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                        nb_start, nb_count, nb, geometry, grid)
-                reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
-                continue
-            advance(i, t, disks, geometry, grid)
+        advance(i, t, disks, geometry, grid)
+        j = partner  # the second disk to re-predict, when it is a disk contact
+        if partner >= 0 and coll_count[j] != event_count[i]:
+            stale_events += 1
+            j = NO_EVENT
+        elif partner >= 0:
             advance(j, t, disks, geometry, grid)
             rx = minimum_image(disks[i, X] - disks[j, X], geometry[0], grid[2] != 0)
             ry = minimum_image(disks[i, Y] - disks[j, Y], geometry[1], grid[3] != 0)
@@ -256,14 +267,7 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
                     status = STATUS_COLLAPSE
                     culprit = i if streak[i] > collapse_streak else j
                     break
-            predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                    nb_start, nb_count, nb, geometry, grid)
-            reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
-            predict(j, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                    nb_start, nb_count, nb, geometry, grid)
-            reschedule(heap, links, list_head, calendar, block_rate, event_time, j)
         elif partner == SHELL_EXIT:
-            advance(i, t, disks, geometry, grid)
             full = rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb,
                                       cell_head, cell_next, cell_prev, cell_of, big, geometry,
                                       grid)
@@ -273,26 +277,15 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
                 break
             shell_exits += 1
             events += 1
-            predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                    nb_start, nb_count, nb, geometry, grid)
-            reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
         else:
             wall = WALL_X_LOW - partner
-            axis = wall >> 1
-            advance(i, t, disks, geometry, grid)
-            lo = disks[i, RADIUS]
-            hi = geometry[axis] - disks[i, RADIUS]
-            if disks[i, X + axis] < lo:
-                disks[i, X + axis] = lo
-            elif disks[i, X + axis] > hi:
-                disks[i, X + axis] = hi
             xi_w = 1.0
             if wall_restitution is not None:
                 xi_w = wall_restitution
                 if tc is not None:
                     if t - t_last[i] < tc:
                         xi_w = 1.0
-            lost, impulse = reflect_from_wall(i, axis, xi_w, disks, mass)
+            lost, impulse = hit_wall(i, wall, xi_w, disks, mass, geometry)
             dissipated_walls += lost
             wall_impulse[wall] += impulse
             coll_count[i] += 1
@@ -305,9 +298,15 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
                     status = STATUS_COLLAPSE
                     culprit = i
                     break
-            predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
+        # one call site each for predict and reschedule: numba inlines them wherever they are
+        # called, and with one copy instead of five the loop compiles about four times faster
+        for k in range(1 if j < 0 else 2):
+            moved = i if k == 0 else j
+            predict(moved, t, disks, delta, coll_count, event_time, event_partner, event_count,
                     nb_start, nb_count, nb, geometry, grid)
-            reschedule(heap, links, list_head, calendar, block_rate, event_time, i)
+            reschedule(heap, links, list_head, calendar, block_rate, event_time, moved)
+        if partner >= 0 and j < 0:
+            continue  # a stale event is no event: the clock and the rebase count stay
         t_now = t
         events_to_rebase -= 1
         if events_to_rebase == 0:

@@ -4,7 +4,8 @@ Design after Smallenburg, Eur. Phys. J. E 45, 22 (2022): disk i owns a shell, th
 radius ``delta[i]`` around its centre c_i (its position when the list was last built). Until its
 shell-exit event, disk i stays inside the shell, so i and j can only touch while
 ``|c_i - c_j| < R_i + R_j + δ_i + δ_j``. The neighbour lists hold exactly those pairs and are
-kept symmetric: when i rebuilds, it leaves its old neighbours' lists and joins the new ones'.
+kept symmetric: when i rebuilds, it leaves the lists of the neighbours it loses and joins the
+lists of the ones it gains.
 
 The grid files disks by shell centre, so a disk changes cell only when it rebuilds. Cells are
 sized for the ordinary ("small") disks. The few disks much larger than the rest ("big", e.g. a
@@ -83,15 +84,23 @@ def _remove_from_list(owner, disk, nb_start, nb_count, nb):
 
 
 @njit(cache=True, inline="always")
-def _shells_overlap(i, j, disks, delta, geometry, grid):
-    dx = minimum_image(disks[i, CX] - disks[j, CX], geometry[0], grid[2] != 0)
-    dy = minimum_image(disks[i, CY] - disks[j, CY], geometry[1], grid[3] != 0)
-    reach = (disks[i, RADIUS] + disks[j, RADIUS] + delta[i] + delta[j]) * (1.0 + SHELL_SLACK)
+def _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
+    """Whether the shell of j overlaps a shell of disk i centred at (cx, cy) (NaN: never).
+
+    The reach is summed per disk first, (R_i + δ_i) + (R_j + δ_j), and the separation only
+    changes sign with the order, so the test gives the same answer for (i, j) and (j, i) to the
+    last bit: the lists hold exactly the overlapping pairs, which the rebuild relies on.
+    """
+    dx = minimum_image(cx - disks[j, CX], geometry[0], grid[2] != 0)
+    dy = minimum_image(cy - disks[j, CY], geometry[1], grid[3] != 0)
+    reach = ((disks[i, RADIUS] + delta[i]) + (disks[j, RADIUS] + delta[j])) * (1.0 + SHELL_SLACK)
     return dx * dx + dy * dy < reach * reach
 
 
 @njit(cache=True, inline="always")
 def _axis_span(c, k, nc, periodic):
+    """Cells c - k … c + k along an axis of nc cells: a half-open range of cell indices, which
+    run beyond 0 … nc - 1 on a periodic axis (images, see :func:`_fold`)."""
     if periodic:
         if 2 * k + 1 >= nc:
             return 0, nc
@@ -99,24 +108,33 @@ def _axis_span(c, k, nc, periodic):
     return max(0, c - k), min(nc, c + k + 1)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
-def link_new_neighbours(i, only_higher, disks, delta, nb_start, nb_cap, nb_count, nb,
-                        cell_head, cell_next, cell_of, big, geometry, grid):
-    """Find every disk j whose shell overlaps the shell of i and link the pair.
+@njit(cache=True, inline="always")
+def _fold(a, nc):
+    """Cell index of the image a (-nc ≤ a < 2 nc) along a periodic axis of nc cells; a compare
+    and an add instead of the integer division of ``a % nc``."""
+    if a < 0:
+        return a + nc
+    if a >= nc:
+        return a - nc
+    return a
 
-    Small disks scan the 3×3 cells around their own and the big disks; a big disk scans the
-    cells within its reach. With ``only_higher`` only j > i are linked (initial build).
-    Returns the disk whose list overflowed, or -1; the lists stay symmetric either way.
 
-    Two passes: the scan writes every candidate into the next free slot of i's list and
-    advances the count only on overlap (no branch on the test, whose outcome the branch
-    predictor cannot guess); then i joins the list of each new neighbour.
+@njit(cache=True, inline="always")
+def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
+                         nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
+                         grid):
+    """Append after the list of disk i (its count unchanged) every disk j ≥ first_candidate,
+    j ≠ i, whose shell overlaps the shell of i centred at (cx, cy) but not the one centred at
+    (cx_old, cy_old); NaN for the old centre drops that condition.
+
+    Small disks scan the 3×3 cells around (cx, cy) and the big disks; a big disk scans the cells
+    within its reach. Returns the number of disks found, or -1 when they do not fit the list.
+    Every candidate is written into the next free slot and the number advances only on a hit:
+    no branch on the test, whose outcome the branch predictor cannot guess.
     """
     ncx = grid[0]
     ncy = grid[1]
-    c = cell_index(disks[i, CX], disks[i, CY], geometry, grid)
-    cx = c % ncx
-    cy = c // ncx
+    c = cell_index(cx, cy, geometry, grid)
     if cell_of[i] >= 0:
         kx = 1
         ky = 1
@@ -124,41 +142,45 @@ def link_new_neighbours(i, only_higher, disks, delta, nb_start, nb_cap, nb_count
         reach = disks[i, RADIUS] + delta[i] + geometry[4]
         kx = int(math.ceil(reach / geometry[2]))
         ky = int(math.ceil(reach / geometry[3]))
-    x_lo, x_hi = _axis_span(cx, kx, ncx, grid[2] != 0)
-    y_lo, y_hi = _axis_span(cy, ky, ncy, grid[3] != 0)
-    start = nb_start[i]
-    cap = nb_cap[i]
-    first_new = nb_count[i]
-    count = first_new
+    x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[2] != 0)
+    y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[3] != 0)
+    free = nb_start[i] + nb_count[i]
+    room = nb_cap[i] - nb_count[i]
+    found = 0
     for ay in range(y_lo, y_hi):
-        row = (ay % ncy) * ncx
+        row = _fold(ay, ncy) * ncx
         for ax in range(x_lo, x_hi):
-            j = cell_head[row + ax % ncx]
+            j = cell_head[row + _fold(ax, ncx)]
             while j >= 0:
-                new = ((j != i) & ((j > i) | (not only_higher))
-                       & _shells_overlap(i, j, disks, delta, geometry, grid))
-                if count < cap:
-                    nb[start + count] = j
+                listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
+                new = ((j != i) & (j >= first_candidate) & (not listed)
+                       & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
+                if found < room:
+                    nb[free + found] = j
                 elif new:
-                    return i
-                count += new
+                    return -1
+                found += new
                 j = cell_next[j]
     for b in range(big.shape[0]):
         j = big[b]
-        new = ((j != i) & ((j > i) | (not only_higher))
-               & _shells_overlap(i, j, disks, delta, geometry, grid))
-        if count < cap:
-            nb[start + count] = j
+        listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
+        new = ((j != i) & (j >= first_candidate) & (not listed)
+               & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
+        if found < room:
+            nb[free + found] = j
         elif new:
-            return i
-        count += new
-    for k in range(start + first_new, start + count):
+            return -1
+        found += new
+    return found
+
+
+@njit(cache=True, inline="always")
+def _full_list(first, found, nb_start, nb_cap, nb_count, nb):
+    """The first disk among ``nb[first : first + found]`` whose list is full, or -1."""
+    for k in range(first, first + found):
         j = nb[k]
         if nb_count[j] >= nb_cap[j]:
             return j
-        nb[nb_start[j] + nb_count[j]] = i
-        nb_count[j] += 1
-        nb_count[i] += 1
     return -1
 
 
@@ -167,22 +189,50 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
                        cell_prev, cell_of, big, geometry, grid):
     """New shell for disk i centred on its current position, and its new list.
 
-    Idempotent: if a list overflows (returned disk id ≥ 0) the lists stay symmetric, and
-    calling again after enlarging them completes the rebuild.
+    Only the differences are written. The lists hold exactly the pairs of overlapping shells,
+    so a disk near the new centre is new to the list when its shell overlaps the new shell but
+    not the old one; an old neighbour is dropped when its shell misses the new one. A shell
+    moves by δ between rebuilds, so most neighbours stay and their lists are not touched.
+
+    First the new neighbours are found and every list they join is checked for room; only then
+    are lists changed and the shell moved. On overflow (returned disk id ≥ 0) nothing has
+    changed, and calling again after enlarging the lists does the rebuild.
     """
+    cx = disks[i, X]
+    cy = disks[i, Y]
     start = nb_start[i]
-    for k in range(start, start + nb_count[i]):
-        _remove_from_list(nb[k], i, nb_start, nb_count, nb)
-    nb_count[i] = 0
-    disks[i, CX] = disks[i, X]
-    disks[i, CY] = disks[i, Y]
+    old = nb_count[i]
+    found = _find_new_neighbours(i, cx, cy, disks[i, CX], disks[i, CY], 0, disks, delta,
+                                 nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_of,
+                                 big, geometry, grid)
+    if found < 0:
+        return i
+    full = _full_list(start + old, found, nb_start, nb_cap, nb_count, nb)
+    if full >= 0:
+        return full
+    kept = start
+    for k in range(start, start + old):
+        j = nb[k]
+        if _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
+            nb[kept] = j
+            kept += 1
+        else:
+            _remove_from_list(j, i, nb_start, nb_count, nb)
+    for k in range(start + old, start + old + found):
+        j = nb[k]
+        nb[kept] = j
+        kept += 1
+        nb[nb_start[j] + nb_count[j]] = i
+        nb_count[j] += 1
+    nb_count[i] = kept - start
+    disks[i, CX] = cx
+    disks[i, CY] = cy
     if cell_of[i] >= 0:
-        c = cell_index(disks[i, CX], disks[i, CY], geometry, grid)
+        c = cell_index(cx, cy, geometry, grid)
         if c != cell_of[i]:
             _cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
             _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
-    return link_new_neighbours(i, False, disks, delta, nb_start, nb_cap, nb_count, nb,
-                               cell_head, cell_next, cell_of, big, geometry, grid)
+    return -1
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -202,10 +252,20 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
             c = cell_index(disks[i, CX], disks[i, CY], geometry, grid)
             _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
     for i in range(n):
-        full = link_new_neighbours(i, True, disks, delta, nb_start, nb_cap, nb_count, nb,
-                                   cell_head, cell_next, cell_of, big, geometry, grid)
+        first = nb_start[i] + nb_count[i]
+        found = _find_new_neighbours(i, disks[i, CX], disks[i, CY], np.nan, np.nan, i + 1,
+                                     disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
+                                     cell_next, cell_of, big, geometry, grid)
+        if found < 0:
+            return i
+        full = _full_list(first, found, nb_start, nb_cap, nb_count, nb)
         if full >= 0:
             return full
+        for k in range(first, first + found):
+            j = nb[k]
+            nb[nb_start[j] + nb_count[j]] = i
+            nb_count[j] += 1
+        nb_count[i] += found
     return -1
 
 

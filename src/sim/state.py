@@ -13,7 +13,7 @@ Per-disk arrays (n disks, engine order):
   event_time float64[n], event_partner int32[n], event_count int64[n] — scheduled event;
   links int32[n, 3] — place in the event queue (:mod:`sim.event_queue`);
   nb_start int64[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
-  cell_next, cell_prev, cell_of int32[n] — cell lists; order int64[n] — original index.
+  cell_next, cell_prev, cell_of int32[n] — cell lists; order int32[n] — original index.
 Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
 calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells].
 """
