@@ -14,8 +14,9 @@ NAME = "fig01_single_disk"
 
 
 def runs(quick):
-    events = 1000 if quick else 10_000
-    return {"single_disk": ["scenario=single_disk", f"stop.events={events}"]}
+    events, every = (1000, 0.5) if quick else (10_000, 0.1)
+    return {"single_disk": ["scenario=single_disk", f"stop.events={events}",
+                            f"output.every_time={every}"]}
 
 
 def draw(runs, sweeps, out_dir):

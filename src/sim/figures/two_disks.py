@@ -21,12 +21,13 @@ PERTURBATION = 1e-12
 
 
 def runs(quick):
-    common = ["scenario=two_disks", "stop.collisions=150", "output.every_time=0.01"]
+    common = ["scenario=two_disks", f"stop.collisions={40 if quick else 150}",
+              f"output.every_time={0.1 if quick else 0.05}"]
     moved = f"two_disks.positions=[[0.25,0.5],[0.75,{0.52 + PERTURBATION!r}]]"
     return {"start": common, "perturbed": [*common, moved]}
 
 
-def _animate(ds, out_dir, frames=150):
+def _animate(ds, out_dir, frames=60):
     position = ds["position"].values
     radius = ds["radius"].values
     box = ds.attrs["box"]
