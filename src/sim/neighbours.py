@@ -120,6 +120,22 @@ def _fold(a, nc):
 
 
 @njit(cache=True, inline="always")
+def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb, free,
+              room, geometry, grid):
+    """One candidate j for the search of :func:`_find_new_neighbours`: written into the next
+    free slot, counted when it is new. Returns the new count, or -1 when a new neighbour does
+    not fit the list."""
+    listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
+    new = ((j != i) & (j >= first_candidate) & (not listed)
+           & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
+    if found < room:
+        nb[free + found] = j
+    elif new:
+        return -1
+    return found + new
+
+
+@njit(cache=True, inline="always")
 def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
                          nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
                          grid):
@@ -152,25 +168,16 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
         for ax in range(x_lo, x_hi):
             j = cell_head[row + _fold(ax, ncx)]
             while j >= 0:
-                listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
-                new = ((j != i) & (j >= first_candidate) & (not listed)
-                       & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
-                if found < room:
-                    nb[free + found] = j
-                elif new:
+                found = _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks,
+                                  delta, nb, free, room, geometry, grid)
+                if found < 0:
                     return -1
-                found += new
                 j = cell_next[j]
     for b in range(big.shape[0]):
-        j = big[b]
-        listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
-        new = ((j != i) & (j >= first_candidate) & (not listed)
-               & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
-        if found < room:
-            nb[free + found] = j
-        elif new:
+        found = _consider(big[b], found, i, cx, cy, cx_old, cy_old, first_candidate, disks,
+                          delta, nb, free, room, geometry, grid)
+        if found < 0:
             return -1
-        found += new
     return found
 
 
