@@ -11,7 +11,8 @@ def test_quick_figures(tmp_path):
     main(["--quick", "--out", str(tmp_path)])
     out = tmp_path / "quick"
     for name in ("fig01_single_disk", "fig02_two_disks", "fig03_scattering", "fig04_gas_snapshot",
-                 "fig05_maxwell_boltzmann", "fig06_mixture", "fig07_mixture_cooling"):
+                 "fig05_maxwell_boltzmann", "fig06_mixture", "fig07_mixture_cooling",
+                 "fig08_crater_grid", "fig09_crater_radius", "fig10_crater_speed"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
     x, y, energy = path[:, 2], path[:, 3], path[:, 4]
@@ -35,6 +36,17 @@ def test_quick_figures(tmp_path):
     cooling = np.loadtxt(out / "fig07_mixture_cooling.csv", delimiter=",", skiprows=1)
     assert cooling[0, 2] == pytest.approx(1.0, abs=0.15)  # ξ = 1: equipartition
     assert np.all(np.diff(cooling[:, 2]) > 0)  # the ratio grows as ξ falls, as predicted
+    grid = np.loadtxt(out / "fig08_crater_grid.csv", delimiter=",", skiprows=1)
+    calibrated = float((out / "fig08_crater_grid.csv").read_text().split("calibrated dx = ")[1]
+                       .split(",")[0])
+    assert np.all(grid[grid[:, 0] >= calibrated, 1] == 0)  # the untouched bed has no crater
+    assert np.all(grid[:, 2] > np.pi * 0.05**2)  # the crater is larger than the projectile
+    radius = np.loadtxt(out / "fig09_crater_radius.csv", delimiter=",", skiprows=1)
+    assert np.all(np.diff(radius[:, 2]) > 0)  # larger projectiles dig larger craters
+    speed = np.loadtxt(out / "fig10_crater_speed.csv", delimiter=",", skiprows=1)
+    # no energy scale: the same area at every speed, to the TC model's small effect
+    for column in (2, 5):
+        assert np.ptp(speed[:, column]) < 0.05 * speed[:, column].mean()
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
     main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])

@@ -127,6 +127,19 @@ def test_the_sweep_command_writes_two_run_files(tmp_path):
     assert sweep["position"].dims == ("projectile_radius", "snapshot", "disk", "axis")
     np.testing.assert_array_equal(sweep["radius"].isel(disk=-1), [0.01, 0.02])
     assert (sweep["collisions"].max("snapshot") > 0).all()
+    configs = [yaml.safe_load(c) for c in sweep["config"].values]
+    assert [c["projectile"]["radius"] for c in configs] == [0.01, 0.02]
+
+
+def test_at_rest_stops_once_every_species_has_lost_its_energy(tmp_path):
+    path = runner.run(compose_scene("crater", "stop.energy_fraction=null", "stop.at_rest=0.3",
+                                    "stop.collisions=10000000"), tmp_path)
+    with open_run(path) as ds:
+        assert ds.attrs["stop_reason"] == "at_rest"
+        by_species = ds["kinetic_energy_by_species"].values
+        initial = ds["kinetic_energy"].values[0]
+        assert np.all(by_species[-1] < 0.3 * initial)
+        assert np.any(by_species[-2] >= 0.3 * initial)  # and not a snapshot later
 
 
 def test_open_run_is_lazy_and_labelled(tmp_path):

@@ -65,6 +65,7 @@ class StopConfig:
     events: Optional[int] = None
     time: Optional[float] = None
     energy_fraction: Optional[float] = None
+    at_rest: Optional[float] = None
     wall_seconds: Optional[float] = None
 
 
@@ -189,10 +190,11 @@ def validate(cfg: Any) -> None:
     for key in ("collisions", "events", "time", "wall_seconds"):
         _positive(c, f"stop.{key}", s[key])
     _within("stop.energy_fraction", s.energy_fraction, 0.0, 1.0, "between 0 and 1")
-    if all(s[k] is None for k in ("collisions", "events", "time", "energy_fraction",
+    _within("stop.at_rest", s.at_rest, 0.0, 1.0, "between 0 and 1")
+    if all(s[k] is None for k in ("collisions", "events", "time", "energy_fraction", "at_rest",
                                   "wall_seconds")):
         raise ConfigError("stop", None, "at least one of stop.collisions, stop.events, "
-                          "stop.time, stop.energy_fraction, stop.wall_seconds")
+                          "stop.time, stop.energy_fraction, stop.at_rest, stop.wall_seconds")
     o = c.output
     if o.every_collisions is not None and o.every_time is not None:
         raise ConfigError("output.every_collisions", o.every_collisions,

@@ -24,7 +24,16 @@ from sim.h5md import RunWriter, read_checkpoint, truncate
 from sim.scenes import build_scene
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
-FINISHED = ("collisions", "events", "time", "energy_fraction", "no_events")
+FINISHED = ("collisions", "events", "time", "energy_fraction", "at_rest", "no_events")
+
+
+def at_rest(fraction):
+    """Stop predicate of ``stop.at_rest``: the kinetic energy of every species has fallen below
+    ``fraction`` of the initial total. With no energy scale in hard-disk dynamics (a run at
+    speeds ×λ is the same run in time /λ), it ends every such run at the same stage."""
+    def predicate(engine):
+        return bool(np.all(engine.kinetic_energy_by_species() < fraction * engine.initial_energy))
+    return predicate
 
 
 def _git_commit():
@@ -71,6 +80,7 @@ def advance(engine, cfg, writer, last_time):
     """Run from snapshot to snapshot (the last one at ``last_time``) until a stop condition
     holds; returns its name."""
     stop, out = cfg.stop, cfg.output
+    until = None if stop.at_rest is None else at_rest(stop.at_rest)
     started = wallclock.perf_counter()
     bar = _progress(cfg, engine)
     try:
@@ -86,10 +96,12 @@ def advance(engine, cfg, writer, last_time):
             reason = engine.run(
                 events=stop.events, collisions=None if collisions == math.inf else collisions,
                 time=None if t_stop == math.inf else t_stop,
-                energy_fraction=stop.energy_fraction, wall_seconds=budget)
+                energy_fraction=stop.energy_fraction, wall_seconds=budget, until=until)
             snapshot_time = t_stop if reason == "time" else None
             if reason == "no_events" and t_stop < math.inf:
                 snapshot_time, reason = t_stop, "time"
+            if reason == "predicate" or (until is not None and until(engine)):
+                reason = "at_rest"  # checked between chunks and at every snapshot
             last_time = engine.time if snapshot_time is None else snapshot_time
             last = {"collisions": stop.collisions is not None
                     and engine.collisions >= stop.collisions,

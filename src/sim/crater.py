@@ -1,0 +1,65 @@
+"""Crater measure of the seed study: a grid of square cells of side Δx over the bed; a cell is
+occupied when any bed disk overlaps it; the crater area is the number of empty cells inside
+the bed times Δx².
+
+The disk–square test (the study's Figure 1): a disk of centre c and radius R overlaps the
+square [x₀, x₀ + Δx] × [y₀, y₀ + Δx] exactly when c lies in the square grown by R with
+rounded corners, i.e. when the distance from c to the nearest point of the square,
+|c − clamp(c, square)|, is below R. Touching (distance = R) does not occupy.
+
+Positions, radii and Δx in box units; the grid starts at the box origin, so a bed height
+that is a multiple of Δx is a grid line.
+"""
+
+import numpy as np
+
+
+def occupied_cells(position, radius, dx, extent):
+    """Which cells of a grid of side ``dx`` over [0, extent[0]] × [0, extent[1]] any disk
+    overlaps. ``position`` float64[n, 2], ``radius`` float64[n] or scalar.
+
+    Returns bool[nx, ny], cell (a, b) being [a Δx, (a + 1) Δx] × [b Δx, (b + 1) Δx]; the last
+    row and column may reach past ``extent``.
+    """
+    position = np.asarray(position, dtype=np.float64)
+    radius = np.broadcast_to(np.asarray(radius, dtype=np.float64), (position.shape[0],))
+    nx, ny = (int(np.ceil(extent[a] / dx - 1e-9)) for a in (0, 1))
+    occupied = np.zeros((nx, ny), dtype=bool)
+    reach = int(np.ceil(radius.max() / dx)) if radius.size else 0
+    first = np.floor(position / dx).astype(np.int64)  # cell holding each centre
+    for ox in range(-reach, reach + 1):
+        for oy in range(-reach, reach + 1):
+            a = first[:, 0] + ox
+            b = first[:, 1] + oy
+            inside = (a >= 0) & (a < nx) & (b >= 0) & (b < ny)
+            nearest_x = np.clip(position[:, 0], a * dx, (a + 1) * dx)
+            nearest_y = np.clip(position[:, 1], b * dx, (b + 1) * dx)
+            d2 = (position[:, 0] - nearest_x) ** 2 + (position[:, 1] - nearest_y) ** 2
+            hit = inside & (d2 < radius**2)
+            occupied[a[hit], b[hit]] = True
+    return occupied
+
+
+def crater_area(position, radius, dx, width, bed_height):
+    """Empty-cell area Δx² · #(empty cells) of the grid over the bed [0, width] × [0,
+    bed_height], the cells that reach above ``bed_height`` left out. Returns (area, occupied
+    grid bool[nx, ny])."""
+    ny = int(np.floor(bed_height / dx + 1e-9))
+    occupied = occupied_cells(position, radius, dx, (width, ny * dx))
+    nx = int(np.floor(width / dx + 1e-9))
+    empty = ~occupied[:nx, :ny]
+    return float(empty.sum()) * dx * dx, occupied
+
+
+def calibrated_spacing(position, radius, width, bed_height):
+    """The finest spacing Δx = bed_height / k (k = 1, 2, …; Δx ≥ the largest disk diameter)
+    such that the untouched bed — its disks' ``position`` before the impact — has no empty
+    cell at Δx nor at any coarser spacing of the ladder: the study's rule that the gaps between
+    resting disks must not count as crater."""
+    radius = np.broadcast_to(np.asarray(radius, dtype=np.float64), (len(position),))
+    finest = max(int(bed_height / (2.0 * radius.max())), 1)
+    k = 1
+    while k < finest and crater_area(position, radius, bed_height / (k + 1), width,
+                                     bed_height)[0] == 0:
+        k += 1
+    return bed_height / k

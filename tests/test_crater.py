@@ -1,0 +1,60 @@
+"""The crater measure: the exact disk–square test against the seed study's own construction
+(its Figure 1), empty and full beds, and the calibrated grid spacing."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from sim.crater import calibrated_spacing, crater_area, occupied_cells
+from sim.initial import hexagonal_lattice
+
+
+def overlaps_by_figure_1(cx, cy, radius, x0, y0, x1, y1):
+    """The study's Figure 1: the centre lies in the square [x0, x1] × [y0, y1] grown by R on
+    each side, but not in its corners — unless within R of a corner of the square."""
+    in_cross = ((x0 - radius < cx < x1 + radius and y0 <= cy <= y1)
+                or (x0 <= cx <= x1 and y0 - radius < cy < y1 + radius))
+    corners = ((x0, y0), (x1, y0), (x0, y1), (x1, y1))
+    near_corner = any((cx - a) ** 2 + (cy - b) ** 2 < radius**2 for a, b in corners)
+    return in_cross or near_corner
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(0.0, 1.0), st.floats(0.0, 1.0), st.floats(0.001, 0.2),
+       st.sampled_from([0.05, 0.1, 0.125, 0.2]))
+def test_disk_square_test_matches_the_study_construction(cx, cy, radius, dx):
+    occupied = occupied_cells(np.array([[cx, cy]]), radius, dx, (1.0, 1.0))
+    for a in range(occupied.shape[0]):
+        for b in range(occupied.shape[1]):
+            gap = np.hypot(cx - np.clip(cx, a * dx, (a + 1) * dx),
+                           cy - np.clip(cy, b * dx, (b + 1) * dx))
+            if abs(gap - radius) < 1e-12:
+                continue  # tangent to the cell to round-off: either answer is right
+            assert occupied[a, b] == overlaps_by_figure_1(cx, cy, radius, a * dx, b * dx,
+                                                          (a + 1) * dx, (b + 1) * dx)
+
+
+def test_a_disk_touching_a_corner_occupies_only_when_it_overlaps():
+    dx, radius = 0.1, 0.03
+    corner = np.array([0.3, 0.3])
+    direction = np.array([1.0, 1.0]) / np.sqrt(2.0)
+    outside = occupied_cells([corner + (radius + 1e-12) * direction], radius, dx, (1, 1))
+    inside = occupied_cells([corner + (radius - 1e-12) * direction], radius, dx, (1, 1))
+    assert not outside[2, 2] and inside[2, 2]
+    # plus the cell holding the centre and the two sharing its sides with the corner cell
+    assert outside.sum() == 3 and inside.sum() == 4
+
+
+def test_empty_and_full_beds():
+    area, _ = crater_area(np.empty((0, 2)), np.empty(0), 0.1, 1.0, 0.5)
+    assert area == pytest.approx(0.5, rel=1e-12)  # every cell of the bed empty
+    lattice = hexagonal_lattice(800, 0.01, box=(1.0, 0.5), seed=1)
+    dx = calibrated_spacing(lattice, 0.01, 1.0, 0.5)
+    assert 0.02 <= dx < 0.05
+    assert crater_area(lattice, 0.01, dx, 1.0, 0.5)[0] == 0.0
+    # removing the disks of a disk-shaped hole of radius 0.1 leaves about its area empty
+    kept = np.hypot(lattice[:, 0] - 0.5, lattice[:, 1] - 0.25) > 0.1
+    area, _ = crater_area(lattice[kept], 0.01, dx, 1.0, 0.5)
+    hole = np.pi * (0.1 - 0.01) ** 2  # the disks at the rim reach 0.01 into the hole
+    assert 0.5 * hole < area < 1.2 * hole
