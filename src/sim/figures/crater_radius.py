@@ -3,7 +3,8 @@ from 0.01 to 0.10, mass ∝ R² (the bed's areal density), one Hydra multirun re
 open_sweep, each run stopped at 10 % of its kinetic energy as in the study and measured on
 the grid of figure 8 (one Δx for all: the bed is the same). A power law A = c Rᵅ is fitted by
 least squares in log–log (scipy.stats.linregress), its exponent given with its standard
-error; the study read its data as area ∝ mass, i.e. α = 2. The largest projectiles reach the
+error. Without gravity and with grains much smaller than the projectile, geometric similarity
+gives α = 2 (area ∝ mass, as the study read its data; physics.md, "Cratering"). The largest projectiles reach the
 floor of the half-filled box before 10 % of the energy is left, and their craters saturate:
 one run per radius (one bed), so a single power law is a rough summary, not a law.
 """
