@@ -1,5 +1,6 @@
 """The crater measure: the exact disk–square test against the seed study's own construction
-(its Figure 1), empty and full beds, and the calibrated grid spacing."""
+(its Figure 1), empty and full beds, the calibrated grid spacing; and the scale invariance
+that figure 10 rests on."""
 
 import numpy as np
 import pytest
@@ -7,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sim.crater import calibrated_spacing, crater_area, occupied_cells
+from sim.engine import Engine
 from sim.initial import hexagonal_lattice
 
 
@@ -58,3 +60,25 @@ def test_empty_and_full_beds():
     area, _ = crater_area(lattice[kept], 0.01, dx, 1.0, 0.5)
     hole = np.pi * (0.1 - 0.01) ** 2  # the disks at the rim reach 0.01 into the hole
     assert 0.5 * hole < area < 1.2 * hole
+
+
+def test_a_crater_at_twice_the_speed_is_the_same_crater_in_half_the_time():
+    """Hard disks have no energy scale (figure 10): doubling every velocity and halving t_c
+    gives the same collisions at half the times — to the bit, as ×2 is exact in float64."""
+    bed = hexagonal_lattice(300, 0.012, region=((0, 1), (0, 0.5)), seed=3)
+    n = len(bed)
+    position = np.vstack([bed, [[0.5, 0.75]]])
+    radius = np.append(np.full(n, 0.012), 0.05)
+    mass = np.append(np.ones(n), (0.05 / 0.012) ** 2)
+    runs = []
+    for speed in (5.0, 10.0):
+        velocity = np.zeros((n + 1, 2))
+        velocity[-1] = [0.0, -speed]
+        engine = Engine(position, velocity, radius, mass, restitution=0.5, tc=5e-8 / speed)
+        engine.run(collisions=20_000)
+        runs.append(engine)
+    slow, fast = runs
+    assert slow.time == 2.0 * fast.time
+    np.testing.assert_array_equal(slow.positions(), fast.positions())
+    np.testing.assert_array_equal(2.0 * slow.velocities(), fast.velocities())
+    assert fast.dissipated_energy == 4.0 * slow.dissipated_energy

@@ -37,14 +37,12 @@ def test_quick_figures(tmp_path):
     assert cooling[0, 2] == pytest.approx(1.0, abs=0.15)  # ξ = 1: equipartition
     assert np.all(np.diff(cooling[:, 2]) > 0)  # the ratio grows as ξ falls, as predicted
     grid = np.loadtxt(out / "fig08_crater_grid.csv", delimiter=",", skiprows=1)
-    calibrated = float((out / "fig08_crater_grid.csv").read_text().split("calibrated dx = ")[1]
-                       .split(",")[0])
-    assert np.all(grid[grid[:, 0] >= calibrated, 1] == 0)  # the untouched bed has no crater
     assert np.all(grid[:, 2] > np.pi * 0.05**2)  # the crater is larger than the projectile
+    assert np.all(grid[:, 2] < 0.5)  # and smaller than the bed
     radius = np.loadtxt(out / "fig09_crater_radius.csv", delimiter=",", skiprows=1)
     assert np.all(np.diff(radius[:, 2]) > 0)  # larger projectiles dig larger craters
     speed = np.loadtxt(out / "fig10_crater_speed.csv", delimiter=",", skiprows=1)
-    # no energy scale: the same area at every speed, to the TC model's small effect
+    # no energy scale: the same area at every speed, but for the TC model's fixed t_c
     for column in (2, 5):
         assert np.ptp(speed[:, column]) < 0.05 * speed[:, column].mean()
     # a second call finds its runs and makes none again

@@ -89,6 +89,35 @@ def test_resume_continues_to_the_same_bits(tmp_path, monkeypatch):
         assert b["parameters"].attrs["stop_reason"] == "collisions"
 
 
+def test_frames_buffered_after_a_checkpoint_are_cut_and_made_again(tmp_path, monkeypatch):
+    cfg = compose_scene("gas", "stop.collisions=6000", "output.every_collisions=1000")
+    (tmp_path / "whole").mkdir()
+    whole = runner.run(cfg, tmp_path / "whole")
+    original = runner.RunWriter.snapshot
+    calls = {"n": 0}
+
+    def killed_after_three_unflushed_snapshots(self, engine, time=None, checkpoint=False):
+        self.checkpoint_seconds = self.flush_seconds = 1e9  # only the first one checkpoints
+        original(self, engine, time, checkpoint)
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+
+    (tmp_path / "cut").mkdir()
+    monkeypatch.setattr(runner.RunWriter, "snapshot", killed_after_three_unflushed_snapshots)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run(cfg, tmp_path / "cut")
+    monkeypatch.setattr(runner.RunWriter, "snapshot", original)
+    cut = tmp_path / "cut" / "run.h5"
+    with h5py.File(cut, "r") as f:  # the error path wrote the buffered frames
+        assert f["particles/disks/position/value"].shape[0] == 4
+        assert f["checkpoint"][f["checkpoint"].attrs["latest"]].attrs["snapshots"] == 1
+    runner.resume(cut)
+    with h5py.File(whole, "r") as a, h5py.File(cut, "r") as b:
+        for key in ("particles/disks/position/value", "observables/collisions/value"):
+            np.testing.assert_array_equal(a[key][()], b[key][()], err_msg=key)
+
+
 def run_cli(*args, cwd):
     return subprocess.run([sys.executable, "-m", "sim", *args], cwd=cwd, capture_output=True,
                           text=True, timeout=600)
@@ -101,6 +130,7 @@ def run_cli(*args, cwd):
     "disks.radius=0.01",
     "disks.placement=random disks.packing_fraction=0.7",
     "scenario=crater projectile.radius=-0.01",
+    "stop.at_rest=0",
     "scenario=gas projectile.radius=0.1",
     "scenario=nope",
 ])

@@ -12,7 +12,7 @@ reason, box edges and boundary.
 ``open_sweep(multirun_dir)``: the runs of a Hydra sweep in one Dataset with each swept
 parameter as a dimension (``projectile.radius`` → ``projectile_radius``); runs are aligned by
 snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate; each run's
-resolved config (YAML) is the variable ``config``.
+resolved config (YAML) and stop reason are the variables ``config`` and ``stop_reason``.
 """
 
 from pathlib import Path
@@ -110,28 +110,31 @@ def open_sweep(multirun_dir):
     overrides = [_overrides(run.parent) for run in runs]
     keys = sorted({k for o in overrides for k in o})
     swept = [k for k in keys if len({o.get(k) for o in overrides}) > 1]
-    datasets, configs = [], []
+    datasets, configs, reasons = [], [], []
     for run, override in zip(runs, overrides, strict=True):
         ds = open_run(run).load()
         ds.close()
         ds = ds.rename({"time": "snapshot"}).assign_coords(
             snapshot=np.arange(ds.sizes["time"]), time=("snapshot", ds["time"].values))
         configs.append(ds.attrs.pop("config"))
+        reasons.append(ds.attrs.pop("stop_reason"))
         datasets.append(ds.expand_dims({k.replace(".", "_"): [_value(override[k])]
                                         for k in swept}))
     if not swept:
         combined = xr.concat(datasets, dim="run", join="outer", data_vars="all",
                              coords="different", compat="equals")
         combined["config"] = ("run", np.array(configs, dtype=object))
+        combined["stop_reason"] = ("run", np.array(reasons, dtype=object))
         return combined
     combined = xr.combine_by_coords(datasets, join="outer", combine_attrs="drop_conflicts",
                                     data_vars="all", coords="different", compat="no_conflicts")
     dims = [k.replace(".", "_") for k in swept]
-    config = xr.DataArray(np.empty([combined.sizes[d] for d in dims], dtype=object), dims=dims,
-                          coords={d: combined[d] for d in dims})
-    for override, text in zip(overrides, configs, strict=True):
-        config.loc[{k.replace(".", "_"): _value(override[k]) for k in swept}] = text
-    combined["config"] = config
+    for name, texts in (("config", configs), ("stop_reason", reasons)):
+        per_run = xr.DataArray(np.empty([combined.sizes[d] for d in dims], dtype=object),
+                               dims=dims, coords={d: combined[d] for d in dims})
+        for override, text in zip(overrides, texts, strict=True):
+            per_run.loc[{k.replace(".", "_"): _value(override[k]) for k in swept}] = text
+        combined[name] = per_run
     for name in (k.replace(".", "_") for k in swept):
         combined = combined.sortby(name)
     combined.attrs["swept"] = [k.replace(".", "_") for k in swept]

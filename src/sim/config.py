@@ -190,7 +190,8 @@ def validate(cfg: Any) -> None:
     for key in ("collisions", "events", "time", "wall_seconds"):
         _positive(c, f"stop.{key}", s[key])
     _within("stop.energy_fraction", s.energy_fraction, 0.0, 1.0, "between 0 and 1")
-    _within("stop.at_rest", s.at_rest, 0.0, 1.0, "between 0 and 1")
+    if s.at_rest is not None and not 0.0 < s.at_rest <= 1.0:
+        raise ConfigError("stop.at_rest", s.at_rest, "a fraction in (0, 1]")
     if all(s[k] is None for k in ("collisions", "events", "time", "energy_fraction", "at_rest",
                                   "wall_seconds")):
         raise ConfigError("stop", None, "at least one of stop.collisions, stop.events, "

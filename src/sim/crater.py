@@ -42,13 +42,11 @@ def occupied_cells(position, radius, dx, extent):
 
 def crater_area(position, radius, dx, width, bed_height):
     """Empty-cell area Δx² · #(empty cells) of the grid over the bed [0, width] × [0,
-    bed_height], the cells that reach above ``bed_height`` left out. Returns (area, occupied
-    grid bool[nx, ny])."""
-    ny = int(np.floor(bed_height / dx + 1e-9))
-    occupied = occupied_cells(position, radius, dx, (width, ny * dx))
-    nx = int(np.floor(width / dx + 1e-9))
-    empty = ~occupied[:nx, :ny]
-    return float(empty.sum()) * dx * dx, occupied
+    bed_height], cells reaching past ``width`` or above ``bed_height`` left out. Returns
+    (area, occupied grid bool[nx, ny])."""
+    nx, ny = (int(np.floor(length / dx + 1e-9)) for length in (width, bed_height))
+    occupied = occupied_cells(position, radius, dx, (nx * dx, ny * dx))
+    return float(np.count_nonzero(~occupied)) * dx * dx, occupied
 
 
 def calibrated_spacing(position, radius, width, bed_height):

@@ -53,13 +53,13 @@ def _time_series(group, shape, dtype, unit, description):
     return group
 
 
-def _append(group, steps, times, values):
-    """Append frames (sequences of equal length) to an H5MD time-dependent element."""
-    k = group["step"].shape[0]
+def _write_frames(group, first, steps, times, values):
+    """Write frames (sequences of equal length) into an H5MD time-dependent element from
+    frame ``first`` on, resizing it to end with them (so a retried write does the same)."""
     for name, items in (("step", steps), ("time", times), ("value", values)):
         dataset = group[name]
-        dataset.resize(k + len(items), axis=0)
-        dataset[k:] = np.asarray(items)
+        dataset.resize(first + len(items), axis=0)
+        dataset[first:] = np.asarray(items)
 
 
 class RunWriter:
@@ -77,6 +77,7 @@ class RunWriter:
         self.file = h5py.File(path, mode)
         if mode == "w":
             self._create(engine, parameters)
+        self._flushed_frames = self.file["particles/disks/position/step"].shape[0]
 
     def _create(self, engine, parameters):
         f = self.file
@@ -129,7 +130,7 @@ class RunWriter:
         if checkpoint or now - self._last_checkpoint >= self.checkpoint_seconds:
             self.flush()
             self._checkpoint(engine, t)
-            self._last_checkpoint = now
+            self._last_checkpoint = wallclock.monotonic()
         elif (now - self._last_flush >= self.flush_seconds
               or len(self._frames) * 2 * engine.n * 16 >= self.buffer_bytes):
             self.flush()
@@ -139,11 +140,13 @@ class RunWriter:
         if self._frames:
             steps, times, positions, velocities, observables = zip(*self._frames, strict=True)
             disks = self.file["particles/disks"]
-            _append(disks["position"], steps, times, positions)
-            _append(disks["velocity"], steps, times, velocities)
+            first = self._flushed_frames
+            _write_frames(disks["position"], first, steps, times, positions)
+            _write_frames(disks["velocity"], first, steps, times, velocities)
             for name in OBSERVABLES:
-                _append(self.file["observables"][name], steps, times,
-                        [o[name] for o in observables])
+                _write_frames(self.file["observables"][name], first, steps, times,
+                              [o[name] for o in observables])
+            self._flushed_frames += len(self._frames)
             self._frames.clear()
         self.file.flush()
         self._last_flush = wallclock.monotonic()
@@ -170,6 +173,14 @@ class RunWriter:
         self.file.flush()
         root.attrs["latest"] = slot
 
+    def truncate(self, snapshots):
+        """Drop frames written after the first ``snapshots`` ones (before resuming)."""
+        for group in [self.file["particles/disks/position"], self.file["particles/disks/velocity"],
+                      *self.file["observables"].values()]:
+            for name in ("step", "time", "value"):
+                group[name].resize(snapshots, axis=0)
+        self._flushed_frames = snapshots
+
     def finish(self, reason):
         self.flush()
         self.file["parameters"].attrs["stop_reason"] = reason
@@ -188,11 +199,3 @@ def read_checkpoint(file):
     group.visititems(lambda name, item: state.__setitem__(name, item[()])
                      if isinstance(item, h5py.Dataset) else None)
     return state, float(group.attrs["time"]), int(group.attrs["snapshots"])
-
-
-def truncate(file, snapshots):
-    """Drop frames written after the first ``snapshots`` ones (before resuming)."""
-    for group in [file["particles/disks/position"], file["particles/disks/velocity"],
-                  *file["observables"].values()]:
-        for name in ("step", "time", "value"):
-            group[name].resize(snapshots, axis=0)

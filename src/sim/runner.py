@@ -20,7 +20,7 @@ from tqdm import tqdm
 import sim
 from sim.config import ConfigError, SimConfig, validate
 from sim.engine import Engine
-from sim.h5md import RunWriter, read_checkpoint, truncate
+from sim.h5md import RunWriter, read_checkpoint
 from sim.scenes import build_scene
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
@@ -29,8 +29,9 @@ FINISHED = ("collisions", "events", "time", "energy_fraction", "at_rest", "no_ev
 
 def at_rest(fraction):
     """Stop predicate of ``stop.at_rest``: the kinetic energy of every species has fallen below
-    ``fraction`` of the initial total. With no energy scale in hard-disk dynamics (a run at
-    speeds ×λ is the same run in time /λ), it ends every such run at the same stage."""
+    ``fraction`` of the initial total. Hard-disk dynamics has no energy scale (a run at
+    speeds ×λ is the same run in time /λ, unless the TC model's fixed t_c intervenes), so it
+    ends runs that differ only in their speeds at the same stage."""
     def predicate(engine):
         return bool(np.all(engine.kinetic_energy_by_species() < fraction * engine.initial_energy))
     return predicate
@@ -161,7 +162,7 @@ def resume(path):
     def from_the_checkpoint():
         state, last_time, snapshots = read_checkpoint(writer.file)
         engine.load_state_dict(state)
-        truncate(writer.file, snapshots)
+        writer.truncate(snapshots)
         return advance(engine, cfg, writer, last_time)
 
     _record(writer, from_the_checkpoint)

@@ -43,9 +43,8 @@ def draw(runs, sweeps, out_dir):
         energy = ds["kinetic_energy"].values
     area, occupied = crater_area(end[geometry.bed], geometry.radius, geometry.dx,
                                  geometry.width, geometry.height)
-    nx, ny = int(round(geometry.width / geometry.dx)), int(round(geometry.height / geometry.dx))
-    grid = occupied[:nx, :ny].T.astype(float)
-    extent = (0, nx * geometry.dx, 0, ny * geometry.dx)
+    grid = occupied.T.astype(float)
+    extent = (0, occupied.shape[0] * geometry.dx, 0, occupied.shape[1] * geometry.dx)
     fig, (left, right) = figure(width=11, height=4.4)
     left.imshow(grid, origin="lower", extent=extent, cmap="viridis", vmin=0, vmax=1,
                 interpolation="nearest")
@@ -62,7 +61,7 @@ def draw(runs, sweeps, out_dir):
               title=f"t = {t_end:.3g}, E/E₀ = {energy[-1] / energy[0]:.2f}: "
                     f"crater area {area:.4f}")
     rows = []
-    for k in range(int(geometry.height / (2 * geometry.radius.max())), 4, -2):
+    for k in range(int(geometry.height / (2 * geometry.radius.max())), 4, -1):
         dx = geometry.height / k
         rows.append((dx, geometry.area(start, dx), geometry.area(end, dx)))
     np.savetxt(out_dir / f"{NAME}.csv", np.array(rows), delimiter=",", fmt="%.6g",

@@ -3,8 +3,9 @@ from 0.01 to 0.10, mass ∝ R² (the bed's areal density), one Hydra multirun re
 open_sweep, each run stopped at 10 % of its kinetic energy as in the study and measured on
 the grid of figure 8 (one Δx for all: the bed is the same). A power law A = c Rᵅ is fitted by
 least squares in log–log (scipy.stats.linregress), its exponent given with its standard
-error. Without gravity and with grains much smaller than the projectile, geometric similarity
-gives α = 2 (area ∝ mass, as the study read its data; physics.md, "Cratering"). The largest projectiles reach the
+error. Without gravity and with grains much smaller than the projectile, geometric
+similarity gives α = 2 (area ∝ mass, as the study read its data; physics.md, "Cratering").
+The largest projectiles reach the
 floor of the half-filled box before 10 % of the energy is left, and their craters saturate:
 one run per radius (one bed), so a single power law is a rough summary, not a law.
 """
@@ -31,6 +32,10 @@ def sweeps(quick):
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["radius"])
     radius = ds["projectile_radius"].values
+    unfinished = radius[ds["stop_reason"].values != "energy_fraction"]
+    if unfinished.size:
+        raise ValueError(f"runs with projectile radius {unfinished.tolist()} ended before 10 % "
+                         f"of the energy was left: raise their stop.collisions")
     last = at_last_snapshot(ds, "position")
     geometry = CraterGeometry.of_run(ds.isel(projectile_radius=0))
     area = np.array([geometry.area(last.isel(projectile_radius=k).values)
