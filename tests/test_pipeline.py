@@ -58,27 +58,35 @@ def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
     assert info["n"] == n and info["snapshots"] == frames
 
 
+def interrupted_at_the_fourth_snapshot(cfg, folder, monkeypatch, checkpoint_every_snapshot):
+    """Run ``cfg`` into ``folder`` until a KeyboardInterrupt at its fourth snapshot; with
+    ``checkpoint_every_snapshot`` false only the first snapshot checkpoints and nothing is
+    flushed before the interrupt. Returns the run file."""
+    original = runner.RunWriter.snapshot
+    calls = {"n": 0}
+
+    def interrupted(self, engine, time=None, checkpoint=False):
+        if not checkpoint_every_snapshot:
+            self.checkpoint_seconds = self.flush_seconds = 1e9
+        original(self, engine, time, checkpoint or checkpoint_every_snapshot)
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+
+    folder.mkdir()
+    monkeypatch.setattr(runner.RunWriter, "snapshot", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run(cfg, folder)
+    monkeypatch.setattr(runner.RunWriter, "snapshot", original)
+    return folder / "run.h5"
+
+
 def test_resume_continues_to_the_same_bits(tmp_path, monkeypatch):
     cfg = compose_scene("gas", "stop.collisions=6000", "output.every_collisions=1000",
                         "restitution.disk=0.9", "tc.time=1e-7")
     (tmp_path / "whole").mkdir()
     whole = runner.run(cfg, tmp_path / "whole")
-
-    original = runner.RunWriter.snapshot
-    calls = {"n": 0}
-
-    def killed_at_the_fourth_snapshot(self, engine, time=None, checkpoint=False):
-        original(self, engine, time, checkpoint=True)
-        calls["n"] += 1
-        if calls["n"] == 4:
-            raise KeyboardInterrupt
-
-    (tmp_path / "cut").mkdir()
-    monkeypatch.setattr(runner.RunWriter, "snapshot", killed_at_the_fourth_snapshot)
-    with pytest.raises(KeyboardInterrupt):
-        runner.run(cfg, tmp_path / "cut")
-    monkeypatch.setattr(runner.RunWriter, "snapshot", original)
-    cut = tmp_path / "cut" / "run.h5"
+    cut = interrupted_at_the_fourth_snapshot(cfg, tmp_path / "cut", monkeypatch, True)
     assert summary(cut)["snapshots"] == 4
     runner.resume(cut)
     with h5py.File(whole, "r") as a, h5py.File(cut, "r") as b:
@@ -93,22 +101,7 @@ def test_frames_buffered_after_a_checkpoint_are_cut_and_made_again(tmp_path, mon
     cfg = compose_scene("gas", "stop.collisions=6000", "output.every_collisions=1000")
     (tmp_path / "whole").mkdir()
     whole = runner.run(cfg, tmp_path / "whole")
-    original = runner.RunWriter.snapshot
-    calls = {"n": 0}
-
-    def killed_after_three_unflushed_snapshots(self, engine, time=None, checkpoint=False):
-        self.checkpoint_seconds = self.flush_seconds = 1e9  # only the first one checkpoints
-        original(self, engine, time, checkpoint)
-        calls["n"] += 1
-        if calls["n"] == 4:
-            raise KeyboardInterrupt
-
-    (tmp_path / "cut").mkdir()
-    monkeypatch.setattr(runner.RunWriter, "snapshot", killed_after_three_unflushed_snapshots)
-    with pytest.raises(KeyboardInterrupt):
-        runner.run(cfg, tmp_path / "cut")
-    monkeypatch.setattr(runner.RunWriter, "snapshot", original)
-    cut = tmp_path / "cut" / "run.h5"
+    cut = interrupted_at_the_fourth_snapshot(cfg, tmp_path / "cut", monkeypatch, False)
     with h5py.File(cut, "r") as f:  # the error path wrote the buffered frames
         assert f["particles/disks/position/value"].shape[0] == 4
         assert f["checkpoint"][f["checkpoint"].attrs["latest"]].attrs["snapshots"] == 1
