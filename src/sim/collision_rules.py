@@ -13,7 +13,7 @@ partner touched anything — disk or wall — less than ``t_c`` ago. Wall contac
 disk trapped between a wall and its neighbours cannot collapse against the wall either.
 
 Each function returns ``(dissipated energy, virial term)`` and updates velocities in place in
-the disk table ``disks`` (columns in :mod:`sim.kinematics`), ``mass: float64[n]``.
+the disk table ``disks`` (columns in :mod:`sim.kinematics`); masses are passed as values.
 """
 
 import math
@@ -24,36 +24,39 @@ from sim.kinematics import VX, VY
 
 
 @njit(cache=True, inline="always")
-def collide_disks(i, j, rx, ry, xi, disks, mass):
-    """Apply the impulse of a contact between disks i and j at separation r = r_i - r_j.
+def collide_disks(i, j, rx, ry, xi, disks, m_i, m_j):
+    """Apply the impulse of a contact between disks i and j (masses m_i, m_j) at separation
+    r = r_i - r_j.
 
     Returns (energy dissipated, r·Δp_i). Disks found separating (v_n ≥ 0, possible only by
-    round-off) are left alone.
+    round-off) are left alone. With M = m_i + m_j the velocity changes are
+    Δv_i = -(1 + ξ) v_n (m_j/M) n and Δv_j = +(1 + ξ) v_n (m_i/M) n: two divisions in all.
     """
     r = math.sqrt(rx * rx + ry * ry)
-    nx = rx / r
-    ny = ry / r
+    inverse_r = 1.0 / r
+    nx = rx * inverse_r
+    ny = ry * inverse_r
     v_n = (disks[i, VX] - disks[j, VX]) * nx + (disks[i, VY] - disks[j, VY]) * ny
     if v_n >= 0.0:
         return 0.0, 0.0
-    m_i = mass[i]
-    m_j = mass[j]
-    mu = m_i * m_j / (m_i + m_j)
-    impulse = (1.0 + xi) * mu * v_n
-    disks[i, VX] -= impulse / m_i * nx
-    disks[i, VY] -= impulse / m_i * ny
-    disks[j, VX] += impulse / m_j * nx
-    disks[j, VY] += impulse / m_j * ny
-    return 0.5 * (1.0 - xi * xi) * mu * v_n * v_n, -impulse * r
+    inverse_total = 1.0 / (m_i + m_j)
+    mu = m_i * m_j * inverse_total
+    dv = (1.0 + xi) * v_n * inverse_total
+    dv_i = dv * m_j
+    dv_j = dv * m_i
+    disks[i, VX] -= dv_i * nx
+    disks[i, VY] -= dv_i * ny
+    disks[j, VX] += dv_j * nx
+    disks[j, VY] += dv_j * ny
+    return 0.5 * (1.0 - xi * xi) * mu * v_n * v_n, -(1.0 + xi) * mu * v_n * r
 
 
 @njit(cache=True, inline="always")
-def reflect_from_wall(i, axis, xi_wall, disks, mass):
-    """Reverse the normal velocity of disk i at a wall normal to ``axis``.
+def reflect_from_wall(i, axis, xi_wall, disks, m):
+    """Reverse the normal velocity of disk i (mass m) at a wall normal to ``axis``.
 
     Returns (energy dissipated, momentum given to the wall along the axis).
     """
     v_n = disks[i, VX + axis]
     disks[i, VX + axis] = -xi_wall * v_n
-    m = mass[i]
     return 0.5 * (1.0 - xi_wall * xi_wall) * m * v_n * v_n, m * (1.0 + xi_wall) * v_n

@@ -20,7 +20,8 @@ import numpy as np
 from sim import event_loop as loop
 from sim.event_queue import build_queue, empty_queue
 from sim.kinematics import RADIUS, VX, VY, X, Y
-from sim.neighbours import build_all_neighbours, grow_lists
+from sim.neighbours import build_all_neighbours, grow_lists, list_starts
+from sim.parameters import shared_value
 from sim.state import DiskArrays, disk_table
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
@@ -221,8 +222,6 @@ class Engine:
             density = max(phi_small, 0.6) / (np.pi * median**2)
             reach_big = radius[big] + delta[big] + reach
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
-        nb_start = np.zeros(n, dtype=np.int64)
-        nb_start[1:] = np.cumsum(cap[:-1], dtype=np.int64)
         minus_one = np.full(n, -1, dtype=np.int32)
         heap, links, list_head, calendar, block_rate = empty_queue(n)
         table = disk_table(n)
@@ -231,10 +230,11 @@ class Engine:
         table[:, RADIUS] = radius
         self.disks = DiskArrays(
             table=table, delta=delta, mass=self.mass.copy(), species=self.species.copy(),
-            is_big=is_big, coll_count=np.zeros(n, np.int64), t_last=np.full(n, -np.inf),
+            is_big=is_big, coll_count=np.zeros(n, np.int32), contacts=np.zeros(n, np.int64),
+            t_last=np.full(n, -np.inf),
             streak=np.zeros(n, np.int32), event_time=np.empty(n),
-            event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int64),
-            links=links, nb_start=nb_start, nb_cap=cap, nb_count=np.zeros(n, np.int32),
+            event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int32),
+            links=links, nb_start=list_starts(cap), nb_cap=cap, nb_count=np.zeros(n, np.int32),
             cell_next=minus_one.copy(), cell_prev=minus_one.copy(), cell_of=minus_one.copy(),
             order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
             heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
@@ -242,19 +242,27 @@ class Engine:
             cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32))
         self.packing_fraction = phi
         d = self.disks
+        shell_radius = shared_value(d.delta)
         while True:
-            full = build_all_neighbours(d.table, d.delta, d.is_big, d.nb_start, d.nb_cap,
+            full = build_all_neighbours(d.table, shell_radius, d.is_big, d.nb_start, d.nb_cap,
                                         d.nb_count, d.nb, d.cell_head, d.cell_next,
                                         d.cell_prev, d.cell_of, d.big, self.geometry,
                                         self.grid)
             if full < 0:
                 break
             self._grow_lists(full)
-        loop.predict_all(0.0, d.table, d.delta, d.coll_count, d.event_time, d.event_partner,
-                         d.event_count, d.nb_start, d.nb_count, d.nb, self.geometry, self.grid)
+        loop.predict_all(0.0, d.table, shell_radius, d.coll_count, d.event_time,
+                         d.event_partner, d.event_count, d.nb_start, d.nb_count, d.nb,
+                         self.geometry, self.grid)
         build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()
+
+    def _per_disk_parameters(self):
+        """Shell radius, mass and species as the compiled loop takes them: one number each
+        when every disk has the same (:func:`sim.parameters.shared_value`), else the array."""
+        d = self.disks
+        return shared_value(d.delta), shared_value(d.mass), shared_value(d.species)
 
     def _grow_lists(self, full):
         d = self.disks
@@ -274,7 +282,8 @@ class Engine:
             d = self.disks
             reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
             status, disk = loop.run_events(
-                d.table, d.delta, d.mass, d.species, d.coll_count, d.t_last, d.streak,
+                d.table, *self._per_disk_parameters(), d.coll_count, d.contacts, d.t_last,
+                d.streak,
                 d.event_time, d.event_partner, d.event_count, *d.queue, d.nb_start, d.nb_cap,
                 d.nb_count, d.nb,
                 d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
@@ -378,6 +387,7 @@ class Engine:
     def state_dict(self):
         """Every array that evolves, by name: restoring it into an engine built from the same
         inputs continues the run to the same bits."""
+        loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
         state = {f"disks/{name}": value for name, value in vars(self.disks).items()}
         state.update(counters=self.counters, accumulators=self.accumulators,
                      pair_collisions=self.pair_collisions, wall_impulse=self.wall_impulse,
@@ -414,7 +424,8 @@ class Engine:
 
     def collisions_by_disk(self):
         """Contacts (disk and wall) of each disk so far: int64[n]."""
-        return self._user_order(self.disks.coll_count)
+        loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
+        return self._user_order(self.disks.contacts)
 
     def next_event_time(self):
         """Absolute time of the next scheduled event (possibly stale)."""

@@ -14,6 +14,8 @@ events are re-predicted, never applied.
 Optional effects arrive as arguments that are either ``None`` or a value; numba compiles one
 loop per combination and removes the code of every effect that is ``None``:
 ``restitution`` float64[s, s] per species pair, ``wall_restitution`` float, ``tc`` float.
+Likewise ``mass``, ``species`` and ``delta`` are arrays only when the disks differ in them, and
+otherwise one number (:func:`sim.parameters.per_disk`).
 
 The loop returns ``(status, disk)``; errors are codes, raised as exceptions by the caller.
 """
@@ -40,6 +42,7 @@ from sim.kinematics import (
     wrap,
 )
 from sim.neighbours import rebuild_neighbours
+from sim.parameters import per_disk
 
 # event partners other than a disk
 NO_EVENT = -1
@@ -87,8 +90,8 @@ def advance(i, t, disks, geometry, grid):
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def hit_wall(i, wall, xi_wall, disks, mass, geometry):
-    """Disk i (at the time of contact) touches ``wall`` (0 … 3: 2 axis + side): clamp it
+def hit_wall(i, wall, xi_wall, disks, m, geometry):
+    """Disk i (mass m, at the time of contact) touches ``wall`` (0 … 3: 2 axis + side): clamp it
     inside the box against round-off and reflect it. Returns (energy dissipated, momentum
     given to the wall)."""
     axis = wall >> 1
@@ -98,7 +101,7 @@ def hit_wall(i, wall, xi_wall, disks, mass, geometry):
         disks[i, X + axis] = lo
     elif disks[i, X + axis] > hi:
         disks[i, X + axis] = hi
-    return reflect_from_wall(i, axis, xi_wall, disks, mass)
+    return reflect_from_wall(i, axis, xi_wall, disks, m)
 
 
 @njit(cache=True, inline="always")
@@ -113,7 +116,8 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
     vy = disks[i, VY]
     r_i = disks[i, RADIUS]
     tau = shell_exit_time(minimum_image(x - disks[i, CX], geometry[0], px),
-                          minimum_image(y - disks[i, CY], geometry[1], py), vx, vy, delta[i])
+                          minimum_image(y - disks[i, CY], geometry[1], py), vx, vy,
+                          per_disk(delta, i))
     partner = SHELL_EXIT
     if not px:
         tau_w, side = wall_contact_time(x, vx, r_i, geometry[0])
@@ -145,11 +149,27 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
         event_count[i] = coll_count[partner]
 
 
+@njit(cache=True, inline="always")
+def count_contacts(coll_count, contacts):
+    """Bring the full contact counts ``contacts`` int64[n] up to date with the counters
+    ``coll_count`` int32[n], which wrap at 2³²: correct while no disk makes 2³² contacts
+    between two calls, and it is called at every clock rebase."""
+    for i in range(coll_count.shape[0]):
+        contacts[i] += (np.int64(coll_count[i]) - contacts[i]) & 0xFFFFFFFF
+
+
 @njit(cache=True, _nrt=False, error_model="numpy")
-def rebase_clock(disks, t_last, event_time, heap, links, list_head, calendar, block_rate,
-                 geometry, grid, accumulators):
+def count_all_contacts(coll_count, contacts):
+    """:func:`count_contacts`, called from Python."""
+    count_contacts(coll_count, contacts)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links, list_head,
+                 calendar, block_rate, geometry, grid, accumulators):
     """Bring every disk to the current time and restart the clock there (order-preserving);
-    the event queue is rebuilt for the shifted times."""
+    the event queue is rebuilt for the shifted times, and the contact counts are updated."""
+    count_contacts(coll_count, contacts)
     t0 = accumulators[T_NOW]
     for i in range(disks.shape[0]):
         advance(i, t0, disks, geometry, grid)
@@ -162,7 +182,7 @@ def rebase_clock(disks, t_last, event_time, heap, links, list_head, calendar, bl
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_time,
+def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak, event_time,
                event_partner, event_count, heap, links, list_head, calendar, block_rate,
                nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_prev, cell_of, big,
                geometry, grid, restitution, wall_restitution, tc,
@@ -242,15 +262,16 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
             ry = minimum_image(disks[i, Y] - disks[j, Y], geometry[1], grid[3] != 0)
             xi = 1.0
             if restitution is not None:
-                xi = restitution[species[i], species[j]]
+                xi = restitution[per_disk(species, i), per_disk(species, j)]
                 if tc is not None:
                     if t - t_last[i] < tc or t - t_last[j] < tc:
                         xi = 1.0
-            lost, virial = collide_disks(i, j, rx, ry, xi, disks, mass)
+            lost, virial = collide_disks(i, j, rx, ry, xi, disks, per_disk(mass, i),
+                                         per_disk(mass, j))
             dissipated_disks += lost
             virial_sum += virial
-            s_i = species[i]
-            s_j = species[j]
+            s_i = per_disk(species, i)
+            s_j = per_disk(species, j)
             if s_i <= s_j:
                 pair_collisions[s_i, s_j] += 1
             else:
@@ -285,7 +306,7 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
                 if tc is not None:
                     if t - t_last[i] < tc:
                         xi_w = 1.0
-            lost, impulse = hit_wall(i, wall, xi_w, disks, mass, geometry)
+            lost, impulse = hit_wall(i, wall, xi_w, disks, per_disk(mass, i), geometry)
             dissipated_walls += lost
             wall_impulse[wall] += impulse
             coll_count[i] += 1
@@ -311,8 +332,8 @@ def run_events(disks, delta, mass, species, coll_count, t_last, streak, event_ti
         events_to_rebase -= 1
         if events_to_rebase == 0:
             accumulators[T_NOW] = t_now
-            rebase_clock(disks, t_last, event_time, heap, links, list_head, calendar,
-                         block_rate, geometry, grid, accumulators)
+            rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links,
+                         list_head, calendar, block_rate, geometry, grid, accumulators)
             t_now = 0.0
             t_stop_rel = t_stop - accumulators[T_ORIGIN]
             events_to_rebase = rebase_every

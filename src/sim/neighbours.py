@@ -15,8 +15,9 @@ everyone.
 
 Arrays (n disks):
   disks float64[n, DISK_COLUMNS] — the disk table of :mod:`sim.kinematics`, whose columns
-  CX, CY hold the shell centre; delta float64[n];
-  nb_start int64[n], nb_cap int32[n], nb_count int32[n], nb int32[sum(nb_cap)] — list of disk i
+  CX, CY hold the shell centre; delta float64[n], or one float when every shell has the same
+  radius (:func:`sim.state.per_disk`);
+  nb_start int32[n], nb_cap int32[n], nb_count int32[n], nb int32[sum(nb_cap)] — list of disk i
   is ``nb[nb_start[i] : nb_start[i] + nb_count[i]]``;
   cell_head int32[ncx*ncy], cell_next int32[n], cell_prev int32[n], cell_of int32[n] (-1 big);
   big int32[n_big];
@@ -30,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from sim.kinematics import CX, CY, RADIUS, X, Y, minimum_image
+from sim.parameters import per_disk
 
 #: Relative slack on the shell-overlap test, far above round-off and far below any physics.
 SHELL_SLACK = 1e-9
@@ -93,7 +95,9 @@ def _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
     """
     dx = minimum_image(cx - disks[j, CX], geometry[0], grid[2] != 0)
     dy = minimum_image(cy - disks[j, CY], geometry[1], grid[3] != 0)
-    reach = ((disks[i, RADIUS] + delta[i]) + (disks[j, RADIUS] + delta[j])) * (1.0 + SHELL_SLACK)
+    reach_i = disks[i, RADIUS] + per_disk(delta, i)
+    reach_j = disks[j, RADIUS] + per_disk(delta, j)
+    reach = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
     return dx * dx + dy * dy < reach * reach
 
 
@@ -155,7 +159,7 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
         kx = 1
         ky = 1
     else:
-        reach = disks[i, RADIUS] + delta[i] + geometry[4]
+        reach = disks[i, RADIUS] + per_disk(delta, i) + geometry[4]
         kx = int(math.ceil(reach / geometry[2]))
         ky = int(math.ceil(reach / geometry[3]))
     x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[2] != 0)
@@ -283,6 +287,18 @@ def _copy_lists(nb_start, nb_count, nb, new_start, new_nb):
             new_nb[new_start[i] + k] = nb[nb_start[i] + k]
 
 
+def list_starts(capacity):
+    """Offsets int32[n] of the lists in ``nb`` for the capacities ``capacity``: each list
+    starts where the one before it ends."""
+    ends = np.cumsum(capacity, dtype=np.int64)
+    if ends.size and ends[-1] > np.iinfo(np.int32).max:
+        raise MemoryError(f"the neighbour lists need {ends[-1]} slots, more than int32 indexes; "
+                          f"use fewer disks or a smaller neighbour shell")
+    starts = np.zeros(capacity.size, dtype=np.int32)
+    starts[1:] = ends[:-1]
+    return starts
+
+
 def grow_lists(nb_start, nb_cap, nb_count, nb, disks):
     """Return enlarged neighbour arrays: the lists of ``disks`` double their capacity.
 
@@ -290,8 +306,7 @@ def grow_lists(nb_start, nb_cap, nb_count, nb, disks):
     """
     new_cap = nb_cap.copy()
     new_cap[disks] *= 2
-    new_start = np.zeros_like(nb_start)
-    new_start[1:] = np.cumsum(new_cap[:-1], dtype=np.int64)
-    new_nb = np.full(int(new_start[-1] + new_cap[-1]), -1, dtype=np.int32)
+    new_start = list_starts(new_cap)
+    new_nb = np.full(int(new_cap.sum(dtype=np.int64)), -1, dtype=np.int32)
     _copy_lists(nb_start, nb_count, nb, new_start, new_nb)
     return new_start, new_cap, nb_count, new_nb

@@ -8,11 +8,13 @@ Per-disk arrays (n disks, engine order):
   table float64[n, DISK_COLUMNS] — one 64-byte row per disk: position and velocity, the
       disk's own time, radius, shell centre (columns in :mod:`sim.kinematics`);
   delta float64[n] — neighbour-shell radius; mass float64[n]; species int32[n]; is_big bool[n];
-  coll_count int64[n] — contacts (disk and wall) of each disk, also the staleness counter;
+  coll_count int32[n] — contacts (disk and wall) of each disk modulo 2³², the staleness
+      counter; contacts int64[n] — the same count in full, brought up to date from coll_count
+      at every clock rebase and whenever it is read (:func:`sim.event_loop.count_contacts`);
   t_last float64[n], streak int32[n] — time of the last contact, collapse streak;
-  event_time float64[n], event_partner int32[n], event_count int64[n] — scheduled event;
+  event_time float64[n], event_partner int32[n], event_count int32[n] — scheduled event;
   links int32[n, 3] — place in the event queue (:mod:`sim.event_queue`);
-  nb_start int64[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
+  nb_start int32[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
   cell_next, cell_prev, cell_of int32[n] — cell lists; order int32[n] — original index.
 Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
 calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells].
@@ -24,9 +26,10 @@ import numpy as np
 
 from sim.event_queue import NEXT, PREV
 from sim.kinematics import DISK_COLUMNS
+from sim.neighbours import list_starts
 
-PER_DISK = ("table", "delta", "mass", "species", "is_big", "coll_count", "t_last", "streak",
-            "event_time", "event_partner", "event_count", "links", "nb_start", "nb_cap",
+PER_DISK = ("table", "delta", "mass", "species", "is_big", "coll_count", "contacts", "t_last",
+            "streak", "event_time", "event_partner", "event_count", "links", "nb_start", "nb_cap",
             "nb_count", "cell_next", "cell_prev", "cell_of", "order")
 
 
@@ -47,6 +50,7 @@ class DiskArrays:
     species: np.ndarray
     is_big: np.ndarray
     coll_count: np.ndarray
+    contacts: np.ndarray
     t_last: np.ndarray
     streak: np.ndarray
     event_time: np.ndarray
@@ -100,8 +104,7 @@ class DiskArrays:
         self.heap = new_id[self.heap].astype(self.heap.dtype)
         self.big = np.sort(new_id[self.big]).astype(self.big.dtype)
         # neighbour lists: the same contents, ids remapped, one segment per disk in new order
-        self.nb_start = np.zeros_like(self.nb_start)
-        self.nb_start[1:] = np.cumsum(self.nb_cap[:-1], dtype=np.int64)
+        self.nb_start = list_starts(self.nb_cap)
         index = np.repeat(old_start[perm], old_count[perm]) + _ranks(old_count[perm])
         target = np.repeat(self.nb_start, self.nb_count) + _ranks(self.nb_count)
         nb = np.full(int(self.nb_cap.sum()), -1, dtype=self.nb.dtype)

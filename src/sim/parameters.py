@@ -1,0 +1,36 @@
+"""Per-disk parameters that a scene may give every disk alike.
+
+Mass, species and neighbour-shell radius are per-disk arrays in the engine's state, but most
+scenes give every disk the same value. The compiled loop then takes the number instead of the
+array (:func:`shared_value`), reads it through :func:`per_disk`, and numba compiles a variant
+that never loads the array: a scene pays for polydispersity only when it has some.
+"""
+
+import numpy as np
+from numba import types
+from numba.extending import overload
+
+
+def per_disk(values, i):
+    """The value of a per-disk parameter for disk i inside compiled code: ``values[i]`` for an
+    array, ``values`` itself for a number shared by every disk.
+
+    A scene whose disks share a mass (or a shell radius, or a species) passes the number, and
+    the compiled loop never loads the array: numba compiles the variant for the type it gets.
+    """
+    return values[i] if isinstance(values, np.ndarray) else values
+
+
+@overload(per_disk, inline="always")
+def _per_disk(values, i):
+    if isinstance(values, types.Array):
+        return lambda values, i: values[i]
+    return lambda values, i: values
+
+
+def shared_value(values):
+    """A per-disk array as the compiled loop takes it: its single value (a Python number) when
+    every disk has the same one, else the array itself (see :func:`per_disk`)."""
+    if values.size and np.all(values == values.flat[0]):
+        return values.flat[0].item()
+    return values
