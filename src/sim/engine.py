@@ -20,7 +20,7 @@ import numpy as np
 from sim import event_loop as loop
 from sim.event_queue import build_queue, empty_queue
 from sim.kinematics import RADIUS, VX, VY, X, Y
-from sim.neighbours import build_all_neighbours, grow_lists, list_starts
+from sim.neighbours import build_all_neighbours, grow_lists, list_layout, list_starts
 from sim.parameters import shared_value
 from sim.state import DiskArrays, disk_table
 
@@ -244,16 +244,16 @@ class Engine:
         d = self.disks
         shell_radius = shared_value(d.delta)
         while True:
-            full = build_all_neighbours(d.table, shell_radius, d.is_big, d.nb_start, d.nb_cap,
-                                        d.nb_count, d.nb, d.cell_head, d.cell_next,
-                                        d.cell_prev, d.cell_of, d.big, self.geometry,
-                                        self.grid)
+            full = build_all_neighbours(d.table, shell_radius, d.is_big,
+                                        *list_layout(d.nb_start, d.nb_cap), d.nb_count, d.nb,
+                                        d.cell_head, d.cell_next, d.cell_prev, d.cell_of,
+                                        d.big, self.geometry, self.grid)
             if full < 0:
                 break
             self._grow_lists(full)
         loop.predict_all(0.0, d.table, shell_radius, d.coll_count, d.event_time,
-                         d.event_partner, d.event_count, d.nb_start, d.nb_count, d.nb,
-                         self.geometry, self.grid)
+                         d.event_partner, d.event_count, list_layout(d.nb_start, d.nb_cap)[0],
+                         d.nb_count, d.nb, self.geometry, self.grid)
         build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()
@@ -266,7 +266,10 @@ class Engine:
 
     def _grow_lists(self, full):
         d = self.disks
-        disks = np.union1d([full], np.flatnonzero(d.nb_count >= d.nb_cap))
+        if np.all(d.nb_cap == d.nb_cap[0]):
+            disks = np.arange(self.n)  # all alike, so that they stay alike
+        else:
+            disks = np.union1d([full], np.flatnonzero(d.nb_count >= d.nb_cap))
         d.nb_start, d.nb_cap, d.nb_count, d.nb = grow_lists(d.nb_start, d.nb_cap, d.nb_count,
                                                             d.nb, disks)
 
@@ -284,8 +287,8 @@ class Engine:
             status, disk = loop.run_events(
                 d.table, *self._per_disk_parameters(), d.coll_count, d.contacts, d.t_last,
                 d.streak,
-                d.event_time, d.event_partner, d.event_count, *d.queue, d.nb_start, d.nb_cap,
-                d.nb_count, d.nb,
+                d.event_time, d.event_partner, d.event_count, *d.queue,
+                *list_layout(d.nb_start, d.nb_cap), d.nb_count, d.nb,
                 d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
                 self.grid, self.restitution, self.wall_restitution, self.tc, self.counters,
                 self.accumulators, self.pair_collisions, self.wall_impulse,

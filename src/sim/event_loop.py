@@ -41,7 +41,7 @@ from sim.kinematics import (
     wall_contact_time,
     wrap,
 )
-from sim.neighbours import rebuild_neighbours
+from sim.neighbours import list_start, rebuild_neighbours
 from sim.parameters import per_disk
 
 # event partners other than a disk
@@ -129,7 +129,7 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
         if tau_w < tau:
             tau = tau_w
             partner = WALL_Y_LOW - side
-    start = nb_start[i]
+    start = list_start(nb_start, i)
     for k in range(start, start + nb_count[i]):
         j = nb[k]
         dt = t - disks[j, T_OWN]

@@ -18,7 +18,10 @@ Arrays (n disks):
   CX, CY hold the shell centre; delta float64[n], or one float when every shell has the same
   radius (:func:`sim.state.per_disk`);
   nb_start int32[n], nb_cap int32[n], nb_count int32[n], nb int32[sum(nb_cap)] — list of disk i
-  is ``nb[nb_start[i] : nb_start[i] + nb_count[i]]``;
+  is ``nb[nb_start[i] : nb_start[i] + nb_count[i]]``. When every list has the same capacity
+  (no big disks), the compiled code gets that capacity instead of nb_start and nb_cap
+  (:func:`list_start`, :func:`sim.parameters.per_disk`): a list's start is then computed, not
+  loaded, and the neighbours of a disk are one load closer;
   cell_head int32[ncx*ncy], cell_next int32[n], cell_prev int32[n], cell_of int32[n] (-1 big);
   big int32[n_big];
   geometry float64[5] = (Lx, Ly, cell width x, cell width y, largest small R + δ);
@@ -28,10 +31,33 @@ Arrays (n disks):
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from sim.kinematics import CX, CY, RADIUS, X, Y, minimum_image
 from sim.parameters import per_disk
+
+
+def list_start(nb_start, i):
+    """Where the neighbour list of disk i starts in ``nb``: ``nb_start[i]``, or ``i * nb_start``
+    when ``nb_start`` is the capacity shared by every list."""
+    return nb_start[i] if isinstance(nb_start, np.ndarray) else i * nb_start
+
+
+@overload(list_start, inline="always")
+def _list_start(nb_start, i):
+    if isinstance(nb_start, types.Array):
+        return lambda nb_start, i: nb_start[i]
+    return lambda nb_start, i: i * nb_start
+
+
+def list_layout(nb_start, nb_cap):
+    """``nb_start, nb_cap`` as the compiled code takes them: the shared capacity twice when
+    every list has the same one, else both arrays."""
+    if nb_cap.size and np.all(nb_cap == nb_cap[0]):
+        return int(nb_cap[0]), int(nb_cap[0])
+    return nb_start, nb_cap
+
 
 #: Relative slack on the shell-overlap test, far above round-off and far below any physics.
 SHELL_SLACK = 1e-9
@@ -76,7 +102,7 @@ def _remove_from_list(owner, disk, nb_start, nb_count, nb):
     """Remove ``disk`` (which must be listed) from the list of ``owner``: the last entry
     takes its place. The whole short list is scanned with a select instead of stopping at
     the match, whose position the branch predictor cannot guess."""
-    start = nb_start[owner]
+    start = list_start(nb_start, owner)
     last = start + nb_count[owner] - 1
     found = last
     for k in range(start, last):
@@ -164,8 +190,8 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
         ky = int(math.ceil(reach / geometry[3]))
     x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[2] != 0)
     y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[3] != 0)
-    free = nb_start[i] + nb_count[i]
-    room = nb_cap[i] - nb_count[i]
+    free = list_start(nb_start, i) + nb_count[i]
+    room = per_disk(nb_cap, i) - nb_count[i]
     found = 0
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
@@ -190,7 +216,7 @@ def _full_list(first, found, nb_start, nb_cap, nb_count, nb):
     """The first disk among ``nb[first : first + found]`` whose list is full, or -1."""
     for k in range(first, first + found):
         j = nb[k]
-        if nb_count[j] >= nb_cap[j]:
+        if nb_count[j] >= per_disk(nb_cap, j):
             return j
     return -1
 
@@ -211,7 +237,7 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
     """
     cx = disks[i, X]
     cy = disks[i, Y]
-    start = nb_start[i]
+    start = list_start(nb_start, i)
     old = nb_count[i]
     found = _find_new_neighbours(i, cx, cy, disks[i, CX], disks[i, CY], 0, disks, delta,
                                  nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_of,
@@ -233,7 +259,7 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
         j = nb[k]
         nb[kept] = j
         kept += 1
-        nb[nb_start[j] + nb_count[j]] = i
+        nb[list_start(nb_start, j) + nb_count[j]] = i
         nb_count[j] += 1
     nb_count[i] = kept - start
     disks[i, CX] = cx
@@ -263,7 +289,7 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
             c = cell_index(disks[i, CX], disks[i, CY], geometry, grid)
             _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
     for i in range(n):
-        first = nb_start[i] + nb_count[i]
+        first = list_start(nb_start, i) + nb_count[i]
         found = _find_new_neighbours(i, disks[i, CX], disks[i, CY], np.nan, np.nan, i + 1,
                                      disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
                                      cell_next, cell_of, big, geometry, grid)
@@ -274,7 +300,7 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
             return full
         for k in range(first, first + found):
             j = nb[k]
-            nb[nb_start[j] + nb_count[j]] = i
+            nb[list_start(nb_start, j) + nb_count[j]] = i
             nb_count[j] += 1
         nb_count[i] += found
     return -1
