@@ -23,7 +23,7 @@ run: $(STAMP)  ## run the default scene
 test: $(STAMP)  ## quick tests (long physics runs are marked slow)
 	$(PY) -m pytest -q
 
-validate: $(STAMP)  ## every test, slow physics runs included
+validate: $(STAMP)  ## every test, slow physics runs included; writes outputs/validation/table.md
 	$(PY) -m pytest -q -m ""
 
 figures: $(STAMP)  ## every figure into outputs/figures/ (QUICK=1: small versions)

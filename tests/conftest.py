@@ -1,4 +1,7 @@
-"""Shared, seeded state factories and the overlap audit every dynamics test ends with."""
+"""Shared, seeded state factories, the overlap audit every dynamics test ends with, and the
+validation table the slow studies fill."""
+
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -6,6 +9,7 @@ import pytest
 from sim.audit import outside_box, overlapping_pairs
 from sim.engine import Boundary, Engine
 from sim.initial import fixed_speed, hexagonal_lattice, random_sequential
+from sim.validation import table
 
 
 def gas(n, phi, periodic=(False, False), seed=0, speed=1.0, **engine_options):
@@ -33,3 +37,24 @@ def assert_no_overlap(engine, tolerance=1e-9):
 @pytest.fixture
 def make_gas():
     return gas
+
+
+VALIDATION_TABLE = Path("outputs") / "validation" / "table.md"
+_validation_rows = []
+
+
+@pytest.fixture
+def validation_rows():
+    """Rows of the validation table (sim.validation.Check), collected over the session."""
+    return _validation_rows
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Write and show the validation table when validation studies ran."""
+    if not _validation_rows:
+        return
+    VALIDATION_TABLE.parent.mkdir(parents=True, exist_ok=True)
+    text = table(_validation_rows)
+    VALIDATION_TABLE.write_text(text)
+    terminalreporter.write_sep("=", f"validation table ({VALIDATION_TABLE})")
+    terminalreporter.write(text)

@@ -1,0 +1,342 @@
+"""Validation against theory: each study runs the engine and returns rows of a table.
+
+A row (:class:`Check`) holds the measured value, the reference and its source, the tolerance
+the comparison allows and why, whether it passed, and the wall-clock seconds of its run.
+``tests/test_validation.py`` runs every study as a slow test and writes the table to
+``outputs/validation/`` (``make validate``). Formulas and sources: ../shared/physics.md, and
+for the dense fluid the equation of state of Kolafa & Rottner, Mol. Phys. 104, 3435 (2006).
+
+Units: k_B = 1, unit masses unless stated, 2D temperature T = E_kin/(N − 1) when the total
+momentum is zero (E_kin = (N − 1) T: two degrees of freedom per disk, two fixed by the
+momentum), lengths in box units.
+"""
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+from sim.analysis import granular_temperatures
+from sim.engine import Boundary, Engine
+from sim.initial import hexagonal_lattice, maxwellian, random_sequential, remove_drift
+from sim.theory import garzo_dufty_temperature_ratio
+
+
+@dataclass(frozen=True)
+class Check:
+    """One row of the validation table; ``tolerance`` is absolute, on ``measured``."""
+
+    name: str
+    measured: float
+    reference: float
+    tolerance: float
+    source: str
+    seconds: float | None  # wall-clock seconds of the run; None for further rows of one run
+
+    @property
+    def passed(self):
+        return bool(abs(self.measured - self.reference) <= self.tolerance)
+
+
+# -- equilibrium hard-disk fluid --------------------------------------------------------------
+
+#: Kolafa & Rottner (2006), Eq. (7) with the fit up to ρσ² = 0.90 (φ ≤ 0.707): Z = Σ A_i x^i,
+#: x = φ/(1 − φ), as {i: A_i}. It passes within about one error bar through their molecular
+#: dynamics data (relative errors 2e-6 … 1e-5) and expands to the exact B₃ and the known B₄.
+KOLAFA_ROTTNER = {0: 1.0, 1: 2.0, 2: 1.12801775, 3: 0.00181895291, 4: -0.0526134737,
+                  5: 0.0504960168, 6: -0.0325537792, 7: 0.0134578632, 8: 0.00140888182,
+                  9: -0.00834273601, 10: 0.00694127367, 11: -0.00262254723,
+                  12: 0.000355746352, 22: -5.24672938e-9, 57: 5.88054639e-23}
+
+
+def henderson_z(phi):
+    """Henderson, Mol. Phys. 30, 971 (1975): Z = (1 + φ²/8)/(1 − φ)²."""
+    return (1.0 + phi * phi / 8.0) / (1.0 - phi) ** 2
+
+
+def kolafa_rottner_z(phi):
+    """Compressibility factor of the hard-disk fluid, Kolafa & Rottner (2006) fit."""
+    x = phi / (1.0 - phi)
+    return sum(a * x**i for i, a in KOLAFA_ROTTNER.items())
+
+
+def enskog_collision_frequency(n_density, sigma, chi, temperature, mass=1.0):
+    """Collisions per disk per unit time, ω = 2 n σ χ √(πT/m) (physics.md)."""
+    return 2.0 * n_density * sigma * chi * math.sqrt(math.pi * temperature / mass)
+
+
+def equilibrated_gas(n, phi, collisions_per_disk, seed=1):
+    """Elastic equal disks (unit mass) in the periodic unit box, zero total momentum, run
+    ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
+    radius = math.sqrt(phi / (n * math.pi))
+    periodic = (True, True)
+    if phi > 0.3:
+        position = hexagonal_lattice(n, radius, periodic=periodic, seed=seed)
+    else:
+        position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
+    velocity = remove_drift(maxwellian(np.ones(n), 1.0, seed=seed + 1), np.ones(n))
+    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=periodic))
+    engine.run(collisions=int(collisions_per_disk * n))
+    return engine, radius
+
+
+def block_means(values):
+    """Mean and its standard error from independent blocks."""
+    values = np.asarray(values)
+    return float(values.mean()), float(values.std(ddof=1) / math.sqrt(values.size))
+
+
+def equation_of_state(phi, n=2000, warmup=200, blocks=20, collisions_per_block=200,
+                      seed=1):
+    """Z from the collision virial, Z = 1 + Σ r_ij·Δp_i/(2 N T t), in ``blocks`` blocks, and the
+    collision frequency against Enskog's with the same run's χ = (Z − 1)/(2φ).
+
+    Tolerances: four standard errors of the block means, plus 0.3 % for Henderson's formula
+    at φ ≤ 0.5 (physics.md: good to about 0.5 %) — compared only there — and 1/N relative for
+    the finite box against the Kolafa–Rottner limit.
+    """
+    started = time.perf_counter()
+    engine, radius = equilibrated_gas(n, phi, warmup, seed)
+    temperature = engine.kinetic_energy() / (n - 1)
+    z_blocks, omega_blocks = [], []
+    for _ in range(blocks):
+        t0, v0, c0 = engine.time, engine.virial, engine.collisions
+        engine.run(collisions=c0 + collisions_per_block * n)
+        t = engine.time - t0
+        z_blocks.append(1.0 + (engine.virial - v0) / (2.0 * n * temperature * t))
+        omega_blocks.append(2.0 * (engine.collisions - c0) / (n * t))
+    z, z_error = block_means(z_blocks)
+    omega, omega_error = block_means(omega_blocks)
+    seconds = time.perf_counter() - started
+    chi = (z - 1.0) / (2.0 * phi)
+    rows = [Check(f"Z at φ = {phi}, N = {n}", z, kolafa_rottner_z(phi),
+                  4.0 * z_error + kolafa_rottner_z(phi) / n,
+                  "Kolafa & Rottner 2006 fit", seconds)]
+    if phi <= 0.5:
+        rows.append(Check(f"Z at φ = {phi} (Henderson)", z, henderson_z(phi),
+                          4.0 * z_error + 0.006 * henderson_z(phi), "Henderson 1975", None))
+    omega_enskog = enskog_collision_frequency(n, 2.0 * radius, chi, temperature)
+    rows.append(Check(f"collision frequency at φ = {phi}", omega, omega_enskog,
+                      4.0 * omega_error + 4.0 * omega_enskog * z_error / (z - 1.0),
+                      "Enskog, χ from the same run's Z", None))
+    return rows
+
+
+def maxwell_boltzmann(n=4000, phi=0.3, warmup=20, snapshots=5, apart=10, seed=3):
+    """Speeds after equilibration from equal speeds, against the 2D Maxwell–Boltzmann law at
+    the run's temperature: the KS p-value (pass above 0.01; for one mass the energies give the
+    same statistic) and the kurtosis ⟨v⁴⟩/⟨v²⟩² = 2 (four standard errors)."""
+    started = time.perf_counter()
+    radius = math.sqrt(phi / (n * math.pi))
+    periodic = (True, True)
+    position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
+    angle = np.random.default_rng(seed + 1).uniform(0.0, 2.0 * math.pi, n)
+    velocity = remove_drift(np.stack([np.cos(angle), np.sin(angle)], axis=1), np.ones(n))
+    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=periodic))
+    engine.run(collisions=warmup * n)
+    temperature = engine.kinetic_energy() / (n - 1)
+    speeds = []
+    for _ in range(snapshots):
+        engine.run(collisions=engine.collisions + apart * n)
+        speeds.append(np.linalg.norm(engine.velocities(), axis=1))
+    v = np.concatenate(speeds)
+    seconds = time.perf_counter() - started
+    speed_p = stats.kstest(v, stats.rayleigh(scale=math.sqrt(temperature)).cdf).pvalue
+    v2 = v**2
+    kurtosis = float(np.mean(v2**2) / np.mean(v2) ** 2)
+    # its standard error from the spread over snapshots, which are nearly independent
+    per_snapshot = [np.mean(s**4) / np.mean(s**2) ** 2 for s in speeds]
+    kurtosis_error = float(np.std(per_snapshot, ddof=1) / math.sqrt(len(per_snapshot)))
+    return [
+        Check(f"KS p-value, speeds (N = {n} × {snapshots})", speed_p, 1.0, 0.99,
+              "2D Maxwell–Boltzmann at the run's T", seconds),
+        Check("kurtosis ⟨v⁴⟩/⟨v²⟩²", kurtosis, 2.0, 4.0 * kurtosis_error, "2D Maxwellian", None),
+    ]
+
+
+# -- granular gases ---------------------------------------------------------------------------
+
+def cooling_gas(n, phi, restitution, seed, tc=None, mass=1.0, species=None):
+    """A homogeneous granular gas at T = 1 in the periodic unit box: elastic equilibration
+    (10 collisions per disk), then the same state with restitution ξ."""
+    radius = math.sqrt(phi / (n * math.pi))
+    periodic = (True, True)
+    mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,))
+    position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
+    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
+    elastic = Engine(position, velocity, radius, mass, species,
+                     boundary=Boundary(periodic=periodic))
+    elastic.run(collisions=10 * n)
+    engine = Engine(elastic.positions(), elastic.velocities(), radius, mass, species,
+                    boundary=Boundary(periodic=periodic), restitution=restitution, tc=tc)
+    return engine, radius
+
+
+def haff_cooling(restitution, n=4000, phi=0.1, seed=5, longest=60.0):
+    """Homogeneous cooling: E(C)/E₀ against exp(−(1 − ξ²) C/N) at C/N = 1/(1 − ξ²) (E/E₀ = 1/e),
+    and T(t)/T₀ against Haff's 1/(1 + t/t₀)², t₀ = 4/((1 − ξ²) ω₀) with Enskog's ω₀ (χ from
+    Kolafa–Rottner), at t = t₀ (T/T₀ = 1/4). Then the run goes on, up to C/N = ``longest``,
+    to find where E(C) first departs by more than 5 % from the exponential.
+
+    Tolerances: 2 % on E(C) (the Sonine correction a₂ is below 1 % for ξ ≥ 0.7) and 4 % on T(t)
+    (the collision rate of a cooling gas lags Enskog's a little). The departure is the
+    clustering instability of a box larger than 2√π/(nσ√(1 − ξ²)): dense clusters collide
+    less often per unit energy lost than the homogeneous gas, so the cooling slows.
+    """
+    started = time.perf_counter()
+    engine, radius = cooling_gas(n, phi, restitution, seed)
+    e0 = engine.kinetic_energy()
+    rate = 1.0 - restitution**2
+    chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
+    t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, e0 / (n - 1)))
+    engine.run(collisions=round(n / rate))  # E/E₀ = 1/e comes before T/T₀ = 1/4
+    energy_at_c = engine.kinetic_energy() / e0
+    engine.run(time=t0)
+    temperature_at_t0 = engine.kinetic_energy() / e0
+    departure = math.nan
+    for c_per_n in np.arange(math.ceil(engine.collisions / n), longest + 1.0):
+        engine.run(collisions=round(c_per_n * n))
+        if engine.kinetic_energy() / e0 > 1.05 * math.exp(-rate * engine.collisions / n):
+            departure = engine.collisions / n
+            break
+    seconds = time.perf_counter() - started
+    box_limit = 2.0 * math.sqrt(math.pi) / (n * 2.0 * radius * math.sqrt(rate))
+    where = (f"beyond C/N = {longest:.0f}" if math.isnan(departure)
+             else f"at C/N = {departure:.0f}")
+    return [
+        Check(f"Haff E(C)/E₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, φ = {phi}",
+              energy_at_c, math.exp(-1.0), 0.02 * math.exp(-1.0),
+              f"exp(−(1−ξ²)C/N); departs by 5 % {where}, box 1 > instability length "
+              f"{box_limit:.2f}", seconds),
+        Check(f"Haff T(t₀)/T₀, ξ = {restitution}", temperature_at_t0, 0.25, 0.04 * 0.25,
+              "T₀/(1 + t/t₀)², Enskog ω₀", None),
+    ]
+
+
+def mixture_temperature_ratio(restitution, n=4000, phi=0.1, mass_ratio=4.0, seed=7):
+    """T₂/T₁ of an equimolar mixture of equal-size disks with m₂/m₁ = ``mass_ratio``, against
+    equipartition (ξ = 1) or the homogeneous cooling state of Garzó & Dufty (ξ < 1).
+
+    Temperatures are taken in the frame of the local flow (:func:`sim.analysis.
+    granular_temperatures`) and averaged over C/N = 2 … 8: after the start's transient, before
+    the clustering instability has grown. Tolerance: four standard errors of the seven values,
+    plus 3 % for the theory at ξ < 1 (molecular dynamics agrees within a few percent at low φ,
+    physics.md). At ξ = 1 a second row tests the energies m v²/2 of both species together
+    against the exponential law with mean T (KS p-value above 0.01), which holds for any mass.
+    """
+    started = time.perf_counter()
+    species = np.arange(n) % 2
+    mass = np.where(species == 1, mass_ratio, 1.0)
+    engine, _ = cooling_gas(n, phi, None if restitution == 1.0 else restitution, seed,
+                            mass=mass, species=species)
+    ratios, energies = [], []
+    for c_per_n in range(2, 9):
+        engine.run(collisions=c_per_n * n)
+        temperatures = granular_temperatures(engine.positions()[None], engine.velocities()[None],
+                                             mass, species, engine.box)[0]
+        ratios.append(temperatures[1] / temperatures[0])
+        energies.append(0.5 * mass * np.sum(engine.velocities() ** 2, axis=1))
+    ratio, error = block_means(ratios)
+    seconds = time.perf_counter() - started
+    reference = garzo_dufty_temperature_ratio([1.0, mass_ratio], [0.5, 0.5], restitution)
+    theory_margin = 0.0 if restitution == 1.0 else 0.03 * reference
+    rows = [Check(f"mixture T₂/T₁, m₂/m₁ = {mass_ratio:g}, ξ = {restitution}", ratio, reference,
+                  4.0 * error + theory_margin,
+                  "equipartition" if restitution == 1.0 else "Garzó & Dufty 1999", seconds)]
+    if restitution == 1.0:
+        temperature = engine.kinetic_energy() / (n - 1)
+        p_value = stats.kstest(np.concatenate(energies),
+                               stats.expon(scale=temperature).cdf).pvalue
+        rows.append(Check("KS p-value, energies m v²/2 of both masses", p_value, 1.0, 0.99,
+                          "exponential with mean T, any mass", None))
+    return rows
+
+
+def tc_model(restitution=0.8, n=4000, phi=0.1, seed=5):
+    """The TC model with t_c = 10⁻⁴ mean free times leaves the cooling unchanged: E(C)/E₀ at
+    C/N = 1/(1 − ξ²) with and without it agree within 1 %; and the energy the engine booked as
+    dissipated equals the kinetic energy lost, to round-off (1e-12 relative)."""
+    started = time.perf_counter()
+    rate = 1.0 - restitution**2
+    plain, radius = cooling_gas(n, phi, restitution, seed)
+    chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
+    mean_free_time = 1.0 / enskog_collision_frequency(n, 2.0 * radius, chi, 1.0)
+    with_tc, _ = cooling_gas(n, phi, restitution, seed, tc=1e-4 * mean_free_time)
+    results = []
+    for engine in (plain, with_tc):
+        e0 = engine.kinetic_energy()
+        engine.run(collisions=round(n / rate))
+        results.append((engine.kinetic_energy() / e0, e0 - engine.kinetic_energy(),
+                        engine.dissipated_energy))
+    seconds = time.perf_counter() - started
+    (plain_ratio, _, _), (tc_ratio, lost, booked) = results
+    return [
+        Check("TC (t_c = 1e-4 mean free times): E(C)/E₀ with / without", tc_ratio / plain_ratio,
+              1.0, 0.01, "unchanged cooling (Luding & McNamara 1998)", seconds),
+        Check("dissipated energy booked / kinetic energy lost", booked / lost, 1.0, 1e-12,
+              "exact bookkeeping", None),
+    ]
+
+
+# -- exact two-body results -------------------------------------------------------------------
+
+def two_body(cases=1000, seed=11):
+    """Random binary collisions — masses log-uniform over 10⁻³ … 10³, impact parameter
+    b/a ∈ [0, 0.99], ξ ∈ [0, 1] — against the closed forms (physics.md): the recoil of the
+    target (speed J/m₂ along the line of centres, J = (1 + ξ) μ v cos α), the energy lost
+    (1 − ξ²) μ (v cos α)²/2 and, when elastic, the projectile's scattering angle
+    tan θ₁ = sin χ/(m₁/m₂ + cos χ). The largest relative error of all must stay below 1e-12."""
+    started = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    worst = 0.0
+    v, r1, r2 = 2.0, 0.01, 0.03
+    a = r1 + r2
+    for _ in range(cases):
+        m1, m2 = 10.0 ** rng.uniform(-3.0, 3.0, 2)
+        b_over_a = rng.uniform(0.0, 0.99)
+        xi = 1.0 if rng.random() < 0.25 else rng.uniform(0.0, 1.0)
+        engine = Engine([[0.3, 0.5 + b_over_a * a], [0.6, 0.5]], [[v, 0.0], [0.0, 0.0]],
+                        [r1, r2], mass=[m1, m2], restitution=xi)
+        engine.run(collisions=1)
+        cos_alpha = math.sqrt(1.0 - b_over_a**2)
+        mu = m1 * m2 / (m1 + m2)
+        recoil = engine.velocities()[1]
+        errors = [np.hypot(*recoil) / ((1.0 + xi) * mu * v * cos_alpha / m2) - 1.0]
+        lost = 0.5 * (1.0 - xi**2) * mu * (v * cos_alpha) ** 2
+        if lost > 0.0:
+            errors.append(engine.dissipated_energy / lost - 1.0)
+        if xi == 1.0:
+            chi = 2.0 * math.acos(b_over_a)
+            v1 = engine.velocities()[0]
+            theta1 = math.atan2(math.sin(chi), m1 / m2 + math.cos(chi))
+            errors.append(math.remainder(math.atan2(v1[1], v1[0]) - theta1, 2.0 * math.pi))
+        worst = max(worst, *(abs(e) for e in errors))
+    return [Check(f"two-body: worst relative error of {cases} random collisions", worst, 0.0,
+                  1e-12, "closed forms (physics.md)", time.perf_counter() - started)]
+
+
+#: Every study of the table, by name: a callable returning rows.
+STUDIES = {
+    **{f"equation_of_state_{phi}": (lambda phi=phi: equation_of_state(phi))
+       for phi in (0.2, 0.4, 0.5, 0.6, 0.65)},
+    "maxwell_boltzmann": maxwell_boltzmann,
+    "haff_0.9": lambda: haff_cooling(0.9),
+    "haff_0.8": lambda: haff_cooling(0.8),
+    "mixture_elastic": lambda: mixture_temperature_ratio(1.0),
+    "mixture_0.8": lambda: mixture_temperature_ratio(0.8),
+    "tc_model": tc_model,
+    "two_body": two_body,
+}
+
+
+def table(rows):
+    """The rows as a Markdown table."""
+    lines = ["| check | measured | reference | tolerance | pass | seconds | source |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    for r in rows:
+        lines.append(f"| {r.name} | {r.measured:.6g} | {r.reference:.6g} | ± {r.tolerance:.2g} | "
+                     f"{'pass' if r.passed else 'FAIL'} | "
+                     f"{'same run' if r.seconds is None else f'{r.seconds:.1f}'} | {r.source} |")
+    return "\n".join(lines) + "\n"
