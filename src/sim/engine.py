@@ -20,8 +20,8 @@ import numpy as np
 from sim import event_loop as loop
 from sim.event_queue import build_queue, empty_queue
 from sim.kinematics import RADIUS, VX, VY, X, Y
-from sim.neighbours import build_all_neighbours, grow_lists, list_layout, list_starts
-from sim.parameters import shared_value
+from sim.neighbours import build_all_neighbours, grow_lists, list_starts
+from sim.parameters import common_value
 from sim.state import DiskArrays, disk_table
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
@@ -242,36 +242,50 @@ class Engine:
             cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32))
         self.packing_fraction = phi
         d = self.disks
-        shell_radius = shared_value(d.delta)
+        # per-disk values every disk shares (None where they differ): the compiled code gets
+        # the number, and never loads the array (sim.parameters); delta, mass and species
+        # never change, the list capacity only when the lists grow
+        self._common = {name: common_value(getattr(d, name))
+                        for name in ("delta", "mass", "species")}
+        self._common_capacity = common_value(d.nb_cap)
+        shell_radius = self._per_disk_parameters()[0]
         while True:
-            full = build_all_neighbours(d.table, shell_radius, d.is_big,
-                                        *list_layout(d.nb_start, d.nb_cap), d.nb_count, d.nb,
-                                        d.cell_head, d.cell_next, d.cell_prev, d.cell_of,
-                                        d.big, self.geometry, self.grid)
+            full = build_all_neighbours(d.table, shell_radius, d.is_big, *self._list_layout(),
+                                        d.nb_count, d.nb, d.cell_head, d.cell_next,
+                                        d.cell_prev, d.cell_of, d.big, self.geometry, self.grid)
             if full < 0:
                 break
             self._grow_lists(full)
         loop.predict_all(0.0, d.table, shell_radius, d.coll_count, d.event_time,
-                         d.event_partner, d.event_count, list_layout(d.nb_start, d.nb_cap)[0],
-                         d.nb_count, d.nb, self.geometry, self.grid)
+                         d.event_partner, d.event_count, self._list_layout()[0], d.nb_count,
+                         d.nb, self.geometry, self.grid)
         build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()
 
     def _per_disk_parameters(self):
-        """Shell radius, mass and species as the compiled loop takes them: one number each
-        when every disk has the same (:func:`sim.parameters.shared_value`), else the array."""
-        d = self.disks
-        return shared_value(d.delta), shared_value(d.mass), shared_value(d.species)
+        """Shell radius, mass and species as the compiled loop takes them: the number every
+        disk shares, else the array (:func:`sim.parameters.per_disk`)."""
+        return tuple(getattr(self.disks, name) if value is None else value
+                     for name, value in self._common.items())
+
+    def _list_layout(self):
+        """``nb_start, nb_cap`` as the compiled code takes them: the capacity every list
+        shares, twice (a list then starts at i × capacity, :func:`sim.neighbours.list_start`),
+        else both arrays."""
+        if self._common_capacity is None:
+            return self.disks.nb_start, self.disks.nb_cap
+        return self._common_capacity, self._common_capacity
 
     def _grow_lists(self, full):
         d = self.disks
-        if np.all(d.nb_cap == d.nb_cap[0]):
-            disks = np.arange(self.n)  # all alike, so that they stay alike
-        else:
+        if self._common_capacity is None:
             disks = np.union1d([full], np.flatnonzero(d.nb_count >= d.nb_cap))
+        else:
+            disks = np.arange(self.n)  # all alike, so that they stay alike
         d.nb_start, d.nb_cap, d.nb_count, d.nb = grow_lists(d.nb_start, d.nb_cap, d.nb_count,
                                                             d.nb, disks)
+        self._common_capacity = common_value(d.nb_cap)
 
     def reorder(self):
         """Renumber disks in row order of their grid cells (big disks last) for locality."""
@@ -286,9 +300,8 @@ class Engine:
             reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
             status, disk = loop.run_events(
                 d.table, *self._per_disk_parameters(), d.coll_count, d.contacts, d.t_last,
-                d.streak,
-                d.event_time, d.event_partner, d.event_count, *d.queue,
-                *list_layout(d.nb_start, d.nb_cap), d.nb_count, d.nb,
+                d.streak, d.event_time, d.event_partner, d.event_count, *d.queue,
+                *self._list_layout(), d.nb_count, d.nb,
                 d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
                 self.grid, self.restitution, self.wall_restitution, self.tc, self.counters,
                 self.accumulators, self.pair_collisions, self.wall_impulse,
@@ -407,6 +420,7 @@ class Engine:
                 self.initial_energy = float(value)
             else:
                 setattr(self, key, value)
+        self._common_capacity = common_value(self.disks.nb_cap)
 
     def _user_order(self, values):
         out = np.empty_like(values)

@@ -51,14 +51,6 @@ def _list_start(nb_start, i):
     return lambda nb_start, i: i * nb_start
 
 
-def list_layout(nb_start, nb_cap):
-    """``nb_start, nb_cap`` as the compiled code takes them: the shared capacity twice when
-    every list has the same one, else both arrays."""
-    if nb_cap.size and np.all(nb_cap == nb_cap[0]):
-        return int(nb_cap[0]), int(nb_cap[0])
-    return nb_start, nb_cap
-
-
 #: Relative slack on the shell-overlap test, far above round-off and far below any physics.
 SHELL_SLACK = 1e-9
 

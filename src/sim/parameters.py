@@ -2,7 +2,7 @@
 
 Mass, species and neighbour-shell radius are per-disk arrays in the engine's state, but most
 scenes give every disk the same value. The compiled loop then takes the number instead of the
-array (:func:`shared_value`), reads it through :func:`per_disk`, and numba compiles a variant
+array (:func:`common_value`), reads it through :func:`per_disk`, and numba compiles a variant
 that never loads the array: a scene pays for polydispersity only when it has some.
 """
 
@@ -28,9 +28,10 @@ def _per_disk(values, i):
     return lambda values, i: values
 
 
-def shared_value(values):
-    """A per-disk array as the compiled loop takes it: its single value (a Python number) when
-    every disk has the same one, else the array itself (see :func:`per_disk`)."""
+def common_value(values):
+    """The value every entry of the per-disk array ``values`` shares, as a Python number, or
+    None when they differ. The engine passes that number to the compiled loop instead of the
+    array (see :func:`per_disk`)."""
     if values.size and np.all(values == values.flat[0]):
         return values.flat[0].item()
-    return values
+    return None

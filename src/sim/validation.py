@@ -67,17 +67,19 @@ def enskog_collision_frequency(n_density, sigma, chi, temperature, mass=1.0):
     return 2.0 * n_density * sigma * chi * math.sqrt(math.pi * temperature / mass)
 
 
-def equilibrated_gas(n, phi, collisions_per_disk, seed=1):
-    """Elastic equal disks (unit mass) in the periodic unit box, zero total momentum, run
-    ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
+def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None):
+    """Elastic equal-size disks in the periodic unit box at T = 1 with zero total momentum,
+    run ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
     radius = math.sqrt(phi / (n * math.pi))
     periodic = (True, True)
+    mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,))
     if phi > 0.3:
         position = hexagonal_lattice(n, radius, periodic=periodic, seed=seed)
     else:
         position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
-    velocity = remove_drift(maxwellian(np.ones(n), 1.0, seed=seed + 1), np.ones(n))
-    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=periodic))
+    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
+    engine = Engine(position, velocity, radius, mass, species,
+                    boundary=Boundary(periodic=periodic))
     engine.run(collisions=int(collisions_per_disk * n))
     return engine, radius
 
@@ -159,18 +161,11 @@ def maxwell_boltzmann(n=4000, phi=0.3, warmup=20, snapshots=5, apart=10, seed=3)
 # -- granular gases ---------------------------------------------------------------------------
 
 def cooling_gas(n, phi, restitution, seed, tc=None, mass=1.0, species=None):
-    """A homogeneous granular gas at T = 1 in the periodic unit box: elastic equilibration
-    (10 collisions per disk), then the same state with restitution ξ."""
-    radius = math.sqrt(phi / (n * math.pi))
-    periodic = (True, True)
-    mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,))
-    position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
-    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
-    elastic = Engine(position, velocity, radius, mass, species,
-                     boundary=Boundary(periodic=periodic))
-    elastic.run(collisions=10 * n)
-    engine = Engine(elastic.positions(), elastic.velocities(), radius, mass, species,
-                    boundary=Boundary(periodic=periodic), restitution=restitution, tc=tc)
+    """A homogeneous granular gas at T = 1: the equilibrated elastic gas (10 collisions per
+    disk) continued with restitution ξ."""
+    elastic, radius = equilibrated_gas(n, phi, 10, seed, mass, species)
+    engine = Engine(elastic.positions(), elastic.velocities(), radius, elastic.mass, species,
+                    boundary=elastic.boundary, restitution=restitution, tc=tc)
     return engine, radius
 
 
