@@ -5,7 +5,8 @@ disks in a periodic box (Smallenburg, Eur. Phys. J. E 45, 22 (2022)): one event 
 neighbour shells rebuilt from a cell grid (lists of fixed capacity, cleared and refilled),
 collision counters against stale events, lazy positions, and sim's own calendar queue and
 contact-time roots. No walls, masses, species, big disks, effects, observables, stop
-conditions or renumbering. Both engines use the shell diameter r_n = 2σ here.
+conditions or renumbering. Both engines use the same shell diameter r_n (sim's default for
+the packing fraction unless ``--shell`` is given).
 
 Both engines start from the same equilibrated state and run in alternating chunks in one
 process, so that a busy machine slows both alike; the ratio of their rates is what this
@@ -16,6 +17,7 @@ prints. On a quiet machine the minimal engine runs at the speed the fastest C co
 """
 
 import argparse
+import math
 import statistics
 import time
 
@@ -23,14 +25,10 @@ import numpy as np
 from numba import njit
 
 from engine_rate import equal_disks
-from sim.engine import Boundary, Engine
+from sim.engine import Boundary, Engine, shell_ratio
 from sim.event_queue import build_queue, earliest, empty_queue, reschedule
 from sim.kinematics import minimum_image, pair_contact_time, shell_exit_time, wrap
 
-#: Neighbour-list capacity of the minimal engine (mean 6.8, at most 11 at φ = 0.5 with
-#: r_n = 2σ); it does not check for overflow, so φ is limited to MAX_PHI.
-CAPACITY = 24
-MAX_PHI = 0.75
 SHELL_EXIT = -2
 
 
@@ -162,8 +160,13 @@ def run(collisions, p, nb, nb_count, head, following, preceding, cell, count, ev
 class MinimalEngine:
     """Equal elastic disks of radius ``radius`` in the periodic unit box, at time 0."""
 
-    def __init__(self, position, velocity, radius, shell=2.0):
+    def __init__(self, position, velocity, radius, shell):
         n = len(position)
+        phi = n * math.pi * radius**2
+        # lists do not grow: room for the mean number of neighbours 4φ (r_n/σ)² plus eight
+        # standard deviations of its fluctuations and a margin
+        expected = 4.0 * phi * shell**2
+        capacity = int(expected + 8.0 * math.sqrt(expected) + 16.0)
         self.length, self.sigma = 1.0, 2.0 * radius
         self.delta = 0.5 * (shell - 1.0) * self.sigma
         reach = self.sigma + 2.0 * self.delta
@@ -174,7 +177,7 @@ class MinimalEngine:
         self.p[:, 0:2] = position
         self.p[:, 2:4] = velocity
         self.p[:, 5:7] = position
-        self.nb = np.full((n, CAPACITY), -1, np.int32)
+        self.nb = np.full((n, capacity), -1, np.int32)
         self.nb_count = np.zeros(n, np.int32)
         self.head = np.full(self.cells**2, -1, np.int32)
         self.following = np.full(n, -1, np.int32)
@@ -206,13 +209,14 @@ class MinimalEngine:
             self.delta, self.reach_squared)
 
 
-def compare(n, phi, chunk, rounds, warmup):
+def compare(n, phi, chunk, rounds, warmup, shell):
     """Rates (collisions/s) of both engines in alternating chunks after a common warm-up."""
     position, velocity, radius = equal_disks(n, phi)
+    shell = shell_ratio(phi) if shell is None else shell
     engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
-                    shell=2.0)
+                    shell=shell)
     engine.run(collisions=int(warmup * n))
-    minimal = MinimalEngine(engine.positions(), engine.velocities(), radius)
+    minimal = MinimalEngine(engine.positions(), engine.velocities(), radius, shell)
     minimal.run(chunk // 10)
     rates = {"sim": [], "minimal": []}
     for _ in range(rounds):
@@ -224,7 +228,8 @@ def compare(n, phi, chunk, rounds, warmup):
         engine.run(collisions=c0 + chunk)
         rates["sim"].append((engine.collisions - c0) / (time.perf_counter() - started))
     ratios = [s / m for s, m in zip(rates["sim"], rates["minimal"], strict=True)]
-    return {"n": n, "phi": phi, "sim_collisions_per_s": round(max(rates["sim"])),
+    return {"n": n, "phi": phi, "shell": round(shell, 2),
+            "sim_collisions_per_s": round(max(rates["sim"])),
             "minimal_collisions_per_s": round(max(rates["minimal"])),
             "sim_over_minimal": round(statistics.median(ratios), 3)}
 
@@ -236,14 +241,14 @@ def main(argv=None):
     parser.add_argument("--chunk", type=int, default=1_000_000, help="collisions per round")
     parser.add_argument("--rounds", type=int, default=8)
     parser.add_argument("--warmup", type=float, default=10.0, help="collisions per disk")
+    parser.add_argument("--shell", type=float, default=None,
+                        help="shell diameter r_n/σ for both (default: sim's for each φ)")
     args = parser.parse_args(argv)
-    if max(args.phi) > MAX_PHI:
-        parser.error(f"--phi must not exceed {MAX_PHI} (fixed list capacity {CAPACITY})")
-    print("n | phi | sim_collisions_per_s | minimal_collisions_per_s | sim_over_minimal")
-    print("--- | --- | --- | --- | ---")
+    print("n | phi | shell | sim_collisions_per_s | minimal_collisions_per_s | sim_over_minimal")
+    print("--- | --- | --- | --- | --- | ---")
     for n in args.n:
         for phi in args.phi:
-            row = compare(n, phi, args.chunk, args.rounds, args.warmup)
+            row = compare(n, phi, args.chunk, args.rounds, args.warmup, args.shell)
             print(" | ".join(str(v) for v in row.values()), flush=True)
     print("\nrates: best chunk; ratio: median over rounds of sim / minimal in the same round")
 
