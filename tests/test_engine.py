@@ -233,3 +233,21 @@ def test_bad_input_is_rejected():
         Engine([[0.5, 0.5]], [[1.0, 0.0]], 0.1, restitution=1.5)
     with pytest.raises(ValueError, match="radius"):
         Engine([[0.5, 0.5]], [[1.0, 0.0]], -0.1)
+
+
+def test_neutral_effects_run_the_code_of_absent_ones():
+    """ξ = 1, ξ_w = 1, t_c = 0, equal masses and one species switch nothing on: the engine
+    passes the compiled loop what it passes when they are absent, so it runs the same
+    specialisation (and the same bits)."""
+    absent = gas(400, 0.4, seed=71)
+    n = absent.n
+    neutral = gas(400, 0.4, seed=71, restitution=1.0, wall_restitution=1.0, tc=0.0,
+                  mass=np.full(n, 1.0), species=np.zeros(n, dtype=int))
+    assert (neutral.restitution, neutral.wall_restitution, neutral.tc) == (None, None, None)
+    assert neutral._per_disk_parameters() == absent._per_disk_parameters()
+    assert neutral._list_layout() == absent._list_layout()
+    absent.run(collisions=20_000)
+    neutral.run(collisions=20_000)
+    np.testing.assert_array_equal(neutral.positions(), absent.positions())
+    polydisperse = gas(400, 0.4, seed=71, mass=np.linspace(1.0, 2.0, n))
+    assert isinstance(polydisperse._per_disk_parameters()[1], np.ndarray)
