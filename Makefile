@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: help venv run test validate bench figures lint clean
+.PHONY: help venv run test validate bench figures accuracy lint clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -28,6 +28,9 @@ validate: $(STAMP)  ## every test, slow physics runs included; writes outputs/va
 
 figures: $(STAMP)  ## every figure into outputs/figures/ (QUICK=1: small versions)
 	$(PY) -m sim.figures $(if $(QUICK),--quick)
+
+accuracy: $(STAMP)  ## accuracy against wall time for every knob into outputs/accuracy_cost/ (QUICK=1: fewer settings)
+	$(PY) experiments/accuracy_cost/study.py $(if $(QUICK),--quick)
 
 bench: $(STAMP)  ## engine rate table (see benchmarks/engine_rate.py --help)
 	$(PY) benchmarks/engine_rate.py
