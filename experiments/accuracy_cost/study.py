@@ -46,6 +46,7 @@ from sim.validation import (
     enskog_collision_frequency,
     equilibrated_gas,
     kolafa_rottner_z,
+    virial_blocks,
 )
 
 
@@ -56,18 +57,6 @@ def knob(name, setting, unit, reference, **variables):
                       attrs={"knob": name, "unit": unit, "reference": reference})
 
 
-def virial_z(engine, blocks, collisions_per_block):
-    """Z in ``blocks`` consecutive blocks (the run continues from where it is)."""
-    n = engine.n
-    temperature = engine.kinetic_energy() / (n - 1)
-    values = []
-    for _ in range(blocks):
-        t0, v0, c0 = engine.time, engine.virial, engine.collisions
-        engine.run(collisions=c0 + collisions_per_block * n)
-        values.append(1.0 + (engine.virial - v0) / (2.0 * n * temperature * (engine.time - t0)))
-    return np.array(values)
-
-
 def n_disks(quick):
     """Z at φ = 0.5 for N disks: 50 collisions per disk of equilibration, 20 blocks of 20."""
     phi, reference = 0.5, kolafa_rottner_z(0.5)
@@ -76,7 +65,7 @@ def n_disks(quick):
     for n in sizes:
         started = time.perf_counter()
         engine, _ = equilibrated_gas(n, phi, 50)
-        z, z_error = block_means(virial_z(engine, 20, 20))
+        z, z_error = block_means(virial_blocks(engine, 20, 20)[0])
         seconds.append(time.perf_counter() - started)
         error.append(abs(z / reference - 1.0))
         bar.append(2.0 * z_error / reference)
@@ -98,7 +87,7 @@ def collisions(quick):
     blocks, error, bar, seconds = [], [], [], []
     started = time.perf_counter()
     for length in lengths:
-        blocks.extend(virial_z(engine, length // 10 - len(blocks), 10))
+        blocks.extend(virial_blocks(engine, length // 10 - len(blocks), 10)[0])
         z, z_error = block_means(blocks)
         seconds.append(time.perf_counter() - started)
         error.append(abs(z / reference - 1.0))

@@ -96,6 +96,22 @@ def block_means(values):
     return float(values.mean()), float(values.std(ddof=1) / math.sqrt(values.size))
 
 
+def virial_blocks(engine, blocks, collisions_per_block):
+    """Run an elastic engine on in ``blocks`` consecutive blocks of ``collisions_per_block``
+    collisions per disk; returns, per block, Z = 1 + Σ r_ij·Δp_i/(2 N T t) from the collision
+    virial and the collision frequency per disk ω = 2 C/(N t). T = E_kin/(N − 1)."""
+    n = engine.n
+    temperature = engine.kinetic_energy() / (n - 1)
+    z, omega = [], []
+    for _ in range(blocks):
+        t0, v0, c0 = engine.time, engine.virial, engine.collisions
+        engine.run(collisions=c0 + collisions_per_block * n)
+        t = engine.time - t0
+        z.append(1.0 + (engine.virial - v0) / (2.0 * n * temperature * t))
+        omega.append(2.0 * (engine.collisions - c0) / (n * t))
+    return np.array(z), np.array(omega)
+
+
 def equation_of_state(phi, n=2000, warmup=200, blocks=20, collisions_per_block=200,
                       seed=1):
     """Z from the collision virial, Z = 1 + Σ r_ij·Δp_i/(2 N T t), in ``blocks`` blocks, and the
@@ -108,13 +124,7 @@ def equation_of_state(phi, n=2000, warmup=200, blocks=20, collisions_per_block=2
     started = time.perf_counter()
     engine, radius = equilibrated_gas(n, phi, warmup, seed)
     temperature = engine.kinetic_energy() / (n - 1)
-    z_blocks, omega_blocks = [], []
-    for _ in range(blocks):
-        t0, v0, c0 = engine.time, engine.virial, engine.collisions
-        engine.run(collisions=c0 + collisions_per_block * n)
-        t = engine.time - t0
-        z_blocks.append(1.0 + (engine.virial - v0) / (2.0 * n * temperature * t))
-        omega_blocks.append(2.0 * (engine.collisions - c0) / (n * t))
+    z_blocks, omega_blocks = virial_blocks(engine, blocks, collisions_per_block)
     z, z_error = block_means(z_blocks)
     omega, omega_error = block_means(omega_blocks)
     seconds = time.perf_counter() - started
