@@ -12,6 +12,10 @@ Knobs (one function each, returning an xarray Dataset over the knob's settings w
   crater_stop        crater area against the area at rest, by when the run stops
   snapshot_cadence   seconds per snapshot and file size against the snapshot interval
 
+Settings run one after another in one process: their wall-clock seconds are the measurement,
+so they must not share the two cores with each other, which is why the knobs are loops here
+and not a parallel Hydra sweep. The crater and snapshot knobs run the Hydra-composed scenes.
+
 Output in ``--out`` (default outputs/accuracy_cost): ``<knob>.nc``, ``<knob>.png``,
 ``pareto.png`` (every knob's error against seconds) and ``summary.md``.
 
