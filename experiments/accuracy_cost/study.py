@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 from matplotlib import pyplot as plt
+from matplotlib.ticker import NullFormatter
 from scipy import stats
 
 from sim.analysis import open_run
@@ -288,12 +289,28 @@ def plot(ds, out):
     error = ds["error"].values
     ax.errorbar(ds["seconds"].values, error, yerr=ds["error_bar"].values
                 if "error_bar" in ds else None, fmt="o-", capsize=3)
+    seconds = ds["seconds"].values
+    if "error_bar" in ds:
+        # the statistical error alone (2σ), and for the collisions knob the 1/√C law through
+        # its longest run: correlated samples are inside the block estimate
+        ax.plot(seconds, ds["error_bar"], "v:", color="C1", label="2σ from blocks")
+        if ds.attrs["knob"] == "collisions":
+            setting = ds["setting"].values
+            ax.plot(seconds, ds["error_bar"].values[-1] * np.sqrt(setting[-1] / setting), "--",
+                    color="0.5", label="∝ 1/√C")
+    if "naive_error_bar" in ds:
+        ax.plot(seconds, ds["naive_error_bar"], "^:", color="C2",
+                label="2σ/√samples, as if independent")
+    if "error_bar" in ds or "naive_error_bar" in ds:
+        ax.legend(fontsize=7)
     for s, x, y in zip(ds["setting"].values, ds["seconds"].values, error, strict=True):
         if np.isfinite(y) and y > 0:
             ax.annotate(f"{s:g}", (x, y), textcoords="offset points", xytext=(4, 4),
                         fontsize=7)
-    ax.set(xscale="log", yscale="log", xlabel="wall-clock seconds", ylabel="relative error",
-           title=f"{ds.attrs['knob']}: {ds.attrs['unit']}")
+    ax.set(xscale="log", yscale="log", xlabel="wall-clock seconds", ylabel="relative error")
+    ax.set_title(f"{ds.attrs['knob']}\n{ds.attrs['unit']}", fontsize=9)
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.yaxis.set_minor_formatter(NullFormatter())
     ax.text(0.02, 0.02, f"reference: {ds.attrs['reference']}", transform=ax.transAxes,
             fontsize=7)
     fig.savefig(out / f"{ds.attrs['knob']}.png", dpi=120)
@@ -304,8 +321,14 @@ def pareto(datasets, out):
     fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
     for ds in datasets:
         if ds.attrs["knob"] != "snapshot_cadence":
-            ax.plot(ds["seconds"].values, ds["error"].values, "o-", label=ds.attrs["knob"])
-    ax.set(xscale="log", yscale="log", xlabel="wall-clock seconds", ylabel="relative error",
+            # what a measurement can claim: its error, or its 2σ bound when that is larger
+            claim = ds["error"].values
+            if "error_bar" in ds:
+                claim = np.fmax(claim, ds["error_bar"].values)
+            claim = np.where(claim > 0.0, claim, np.nan)  # a reference point has no error
+            ax.plot(ds["seconds"].values, claim, "o-", label=ds.attrs["knob"])
+    ax.set(xscale="log", yscale="log", xlabel="wall-clock seconds",
+           ylabel="relative error (or its 2σ bound, if larger)",
            title="accuracy against cost, every knob")
     ax.legend(fontsize=8)
     fig.savefig(out / "pareto.png", dpi=120)
