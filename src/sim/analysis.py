@@ -5,7 +5,8 @@ Datasets that the figure stages read; nothing here simulates.
 ``disk``, ``axis`` (x, y) and ``species``; variables ``position`` and ``velocity``
 (time, disk, axis) — read lazily from the HDF5 file, so only what is indexed is loaded —
 and the observables (``kinetic_energy``, ``kinetic_energy_by_species``, ``collisions``,
-``wall_collisions``, ``dissipated_energy``, ``collision_virial``); per-disk coordinates
+``wall_collisions``, ``dissipated_energy``, ``collision_virial``, and those of the scene's
+observers, e.g. ``radial_distribution`` over dim and coordinate ``r``); per-disk coordinates
 ``radius``, ``mass``, ``species_id``; attributes: scene, seed, the resolved config (YAML), stop
 reason, box edges and boundary.
 
@@ -60,9 +61,16 @@ def open_run(path):
             "position": _lazy(disks["position/value"], ("time", "disk", "axis")),
             "velocity": _lazy(disks["velocity/value"], ("time", "disk", "axis")),
         }
-        for name in OBSERVABLES:
-            dims = ("time", "species") if name.endswith("by_species") else ("time",)
-            group = f[f"observables/{name}"]
+        axes = {}
+        for name, group in f["observables"].items():
+            if name.endswith("by_species"):
+                dims = ("time", "species")
+            elif name in OBSERVABLES:
+                dims = ("time",)
+            else:  # an observer's: its abscissa is the dataset beside step, time and value
+                axis = next(k for k in group if k not in ("step", "time", "value"))
+                axes[axis] = group[axis][()]
+                dims = ("time", axis)
             data[name] = xr.Variable(dims, group["value"][()],
                                      attrs={"unit": group["value"].attrs.get("unit", ""),
                                             "description": group.attrs.get("description", "")})
@@ -74,7 +82,7 @@ def open_run(path):
             coords={"time": time, "step": ("time", disks["position/step"][()]),
                     "axis": ["x", "y"], "species": np.arange(n_species),
                     "radius": ("disk", disks["radius"][()]), "mass": ("disk", disks["mass"][()]),
-                    "species_id": ("disk", disks["species"][()])},
+                    "species_id": ("disk", disks["species"][()]), **axes},
             attrs={"scene": config.get("scene", ""), "seed": int(parameters["seed"]),
                    "config": str(parameters["config"]),
                    "stop_reason": str(parameters["stop_reason"]),

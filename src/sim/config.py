@@ -78,6 +78,18 @@ class OutputConfig:
 
 
 @dataclass
+class RadialDistributionConfig:
+    bins: Optional[int] = None
+    r_max: float = 4.0
+
+
+@dataclass
+class ObserveConfig:
+    radial_distribution: RadialDistributionConfig = field(
+        default_factory=RadialDistributionConfig)
+
+
+@dataclass
 class ProjectileConfig:
     radius: float = 0.05
     speed: float = 10.0
@@ -122,6 +134,7 @@ class SimConfig:
     tc: TCConfig = field(default_factory=TCConfig)
     stop: StopConfig = field(default_factory=StopConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
+    observe: ObserveConfig = field(default_factory=ObserveConfig)
     projectile: Optional[ProjectileConfig] = None
     bed: Optional[BedConfig] = None
     mixture: Optional[MixtureConfig] = None
@@ -202,6 +215,13 @@ def validate(cfg: Any) -> None:
                           "give output.every_collisions or output.every_time, not both")
     _positive(c, "output.every_collisions", o.every_collisions)
     _positive(c, "output.every_time", o.every_time)
+    rdf = c.observe.radial_distribution
+    if rdf.bins is not None:
+        if rdf.bins < 1:
+            raise ConfigError("observe.radial_distribution.bins", rdf.bins, "at least 1 bin")
+        if not rdf.r_max > 1.0:
+            raise ConfigError("observe.radial_distribution.r_max", rdf.r_max,
+                              "greater than 1 (r in units of the contact distance 2⟨R⟩)")
     if c.scene == "crater":
         p, b = c.projectile, c.bed
         if p is None or b is None:

@@ -8,7 +8,8 @@ Layout written by :class:`RunWriter`:
   /particles/disks/radius, mass, species   time-independent, [N]
   /observables/<name>         step, time, value — kinetic_energy, kinetic_energy_by_species
                               [T, S], collisions, wall_collisions, dissipated_energy,
-                              collision_virial
+                              collision_virial; and one per observer the scene asks for
+                              (:mod:`sim.observers`), with its abscissa beside ``value``
   /parameters                 config (resolved YAML), seed, versions, git commit, stop reason
   /checkpoint/{a,b}           the engine's full state at the last two snapshots, ``latest``
                               naming the complete one (for resume)
@@ -66,8 +67,9 @@ class RunWriter:
     """Creates the run file and appends one frame per :meth:`snapshot`."""
 
     def __init__(self, path, engine, parameters, mode="w", checkpoint_seconds=30.0,
-                 flush_seconds=1.0, buffer_bytes=64 << 20):
+                 flush_seconds=1.0, buffer_bytes=64 << 20, observers=()):
         self.path = path
+        self.observers = list(observers)
         self.checkpoint_seconds = checkpoint_seconds
         self.flush_seconds = flush_seconds
         self.buffer_bytes = buffer_bytes
@@ -106,6 +108,13 @@ class RunWriter:
             shape = (engine.n_species,) if name.endswith("by_species") else ()
             dtype = np.int64 if name.endswith("collisions") else np.float64
             _time_series(observables.create_group(name), shape, dtype, unit, description)
+        for observer in self.observers:
+            group = observables.create_group(observer.name)
+            _time_series(group, observer.shape, observer.dtype, observer.unit,
+                         observer.description)
+            if observer.axis is not None:
+                name, values = observer.axis
+                group.create_dataset(name, data=values)
         p = f.create_group("parameters")
         for key, value in parameters.items():
             p.attrs[key] = value
@@ -124,8 +133,10 @@ class RunWriter:
                        "wall_collisions": engine.wall_collisions,
                        "dissipated_energy": engine.dissipated_energy,
                        "collision_virial": engine.virial}
-        self._frames.append((engine.events, t, engine.positions(t), engine.velocities(),
-                             observables))
+        position = engine.positions(t)
+        for observer in self.observers:
+            observables[observer.name] = observer(engine, position)
+        self._frames.append((engine.events, t, position, engine.velocities(), observables))
         now = wallclock.monotonic()
         if checkpoint or now - self._last_checkpoint >= self.checkpoint_seconds:
             self.flush()
@@ -143,7 +154,7 @@ class RunWriter:
             first = self._flushed_frames
             _write_frames(disks["position"], first, steps, times, positions)
             _write_frames(disks["velocity"], first, steps, times, velocities)
-            for name in OBSERVABLES:
+            for name in observables[0]:
                 _write_frames(self.file["observables"][name], first, steps, times,
                               [o[name] for o in observables])
             self._flushed_frames += len(self._frames)

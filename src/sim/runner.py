@@ -21,6 +21,7 @@ import sim
 from sim.config import ConfigError, SimConfig, validate
 from sim.engine import Engine
 from sim.h5md import RunWriter, read_checkpoint
+from sim.observers import from_config as observers_from_config
 from sim.scenes import build_scene
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
@@ -135,8 +136,9 @@ def run(cfg, output_dir="."):
         cfg = OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
     validate(cfg)
     engine = build_engine(cfg)
+    observers = observers_from_config(cfg, engine)
     path = Path(output_dir) / cfg.output.file
-    writer = RunWriter(path, engine, parameters(cfg))
+    writer = RunWriter(path, engine, parameters(cfg), observers=observers)
 
     def from_the_start():
         writer.snapshot(engine, 0.0)
@@ -157,7 +159,8 @@ def resume(path):
     cfg = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(config_yaml))
     validate(cfg)
     engine = build_engine(cfg)
-    writer = RunWriter(path, engine, parameters(cfg), mode="r+")
+    writer = RunWriter(path, engine, parameters(cfg), mode="r+",
+                       observers=observers_from_config(cfg, engine))
 
     def from_the_checkpoint():
         state, last_time, snapshots = read_checkpoint(writer.file)

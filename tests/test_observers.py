@@ -1,0 +1,29 @@
+"""Observers chosen by the scene (sim.observers), written into the run file and read back."""
+
+import numpy as np
+import pytest
+
+from sim.analysis import open_run
+from sim.figures.runs import compose_config
+from sim.runner import run
+from sim.validation import kolafa_rottner_z
+
+
+def test_radial_distribution_of_a_dense_gas(tmp_path):
+    """g(r) at φ = 0.5 in a periodic box: its value at contact, extrapolated from the first
+    bins above it, is the contact value (Z − 1)/(2φ) of the equation of state, and g → 1 far
+    from a disk."""
+    phi = 0.5
+    cfg = compose_config(["box.boundary=periodic", f"disks.packing_fraction={phi}",
+                          "observe.radial_distribution.bins=400",
+                          "observe.radial_distribution.r_max=10", "stop.collisions=400000",
+                          "output.every_collisions=10000", "output.progress=false"])
+    with open_run(run(cfg, tmp_path)) as ds:
+        assert ds["radial_distribution"].dims == ("time", "r")
+        g = ds["radial_distribution"].isel(time=slice(10, None)).mean("time")
+    above = g.sel(r=slice(1.0, 1.2))  # bin centres above contact, the first one fully
+    slope, contact = np.polyfit(above.r.values[:4] - 1.0, above.values[:4], 1)
+    assert contact == pytest.approx((kolafa_rottner_z(phi) - 1.0) / (2.0 * phi), rel=0.05)
+    assert slope < 0.0
+    assert g.sel(r=slice(0.0, 0.98)).max() == 0.0  # no pair closer than contact
+    assert g.sel(r=slice(8.0, 10.0)).mean() == pytest.approx(1.0, abs=0.01)
