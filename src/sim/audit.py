@@ -8,6 +8,17 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 
+def kd_tree(position, box, periodic):
+    """A k-d tree of ``position`` float64[n, 2] that measures distances with the minimum image
+    on periodic axes (scipy's periodicity is per axis: a huge side makes a walled axis
+    non-periodic)."""
+    box = np.asarray(box, dtype=np.float64)
+    if not any(periodic):
+        return cKDTree(position)
+    boxsize = np.where(periodic, box, 1e30 * max(box.max(), 1.0))
+    return cKDTree(np.where(periodic, position % box, position), boxsize=boxsize)
+
+
 def overlapping_pairs(position, radius, box=(1.0, 1.0), periodic=(False, False),
                       tolerance=1e-9):
     """Pairs (i, j), i < j, with |r_i - r_j| < (R_i + R_j)(1 - tolerance).
@@ -18,12 +29,7 @@ def overlapping_pairs(position, radius, box=(1.0, 1.0), periodic=(False, False),
     position = np.asarray(position, dtype=np.float64)
     radius = np.broadcast_to(np.asarray(radius, dtype=np.float64), (position.shape[0],))
     box = np.asarray(box, dtype=np.float64)
-    if any(periodic):
-        # k-d tree periodicity is per axis; a huge box side makes a walled axis non-periodic
-        boxsize = np.where(periodic, box, 1e30 * max(box.max(), 1.0))
-        tree = cKDTree(np.where(periodic, position % box, position), boxsize=boxsize)
-    else:
-        tree = cKDTree(position)
+    tree = kd_tree(position, box, periodic)
     pairs = tree.query_pairs(2.0 * float(radius.max()), output_type="ndarray")
     if pairs.size == 0:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(0)

@@ -9,8 +9,8 @@ in Python between compiled chunks, never per event; a scene that names none pays
 """
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from sim.audit import kd_tree
 from sim.config import ConfigError
 
 
@@ -37,17 +37,11 @@ class RadialDistribution:
         self.description = (f"g(r) over {bins} bins up to r = {r_max} σ, σ = 2⟨R⟩ = "
                             f"{self.sigma:.6g}; abscissa r (units of σ) in ./r")
         self.area = float(np.prod(engine.box))
-        self.box = np.asarray(engine.box, dtype=np.float64)
-        self.periodic = np.asarray(engine.periodic, dtype=bool)
+        self.box = engine.box
+        self.periodic = engine.periodic
 
     def __call__(self, engine, position):
-        if self.periodic.any():
-            # a huge side makes a walled axis non-periodic in the k-d tree
-            boxsize = np.where(self.periodic, self.box, 1e30 * max(self.box.max(), 1.0))
-            tree = cKDTree(np.where(self.periodic, position % self.box, position),
-                           boxsize=boxsize)
-        else:
-            tree = cKDTree(position)
+        tree = kd_tree(position, self.box, self.periodic)
         distance = tree.sparse_distance_matrix(tree, self.edges[-1], output_type="ndarray")
         distance = distance["v"][distance["i"] < distance["j"]]
         counts = np.histogram(distance, bins=self.edges)[0]
