@@ -27,3 +27,19 @@ def test_radial_distribution_of_a_dense_gas(tmp_path):
     assert slope < 0.0
     assert g.sel(r=slice(0.0, 0.98)).max() == 0.0  # no pair closer than contact
     assert g.sel(r=slice(8.0, 10.0)).mean() == pytest.approx(1.0, abs=0.01)
+
+
+@pytest.mark.parametrize(("overrides", "largest"), [
+    (["disks.packing_fraction=0.8"], (0.99, 1.0)),  # a solid: one cluster of every disk
+    (["disks.packing_fraction=0.05"], (0.0, 0.05)),  # a dilute gas: pairs and loners
+])
+def test_clusters_of_a_solid_and_of_a_dilute_gas(overrides, largest, tmp_path):
+    cfg = compose_config([*overrides, "observe.clusters.gap=0.1", "stop.collisions=20000",
+                          "output.every_collisions=10000", "output.progress=false"])
+    with open_run(run(cfg, tmp_path)) as ds:
+        labels = ds["clusters"].values
+        assert ds["clusters"].dims == ("time", "disk")
+    sizes = [np.bincount(frame) for frame in labels]
+    for size in sizes:
+        assert np.all(np.diff(size) <= 0)  # numbered by decreasing size
+        assert largest[0] <= size[0] / labels.shape[1] <= largest[1]

@@ -128,6 +128,7 @@ def run_cli(*args, cwd):
     "scenario=nope",
     "observe.radial_distribution.bins=0",
     "observe.radial_distribution.bins=50 observe.radial_distribution.r_max=100",
+    "observe.clusters.gap=-1",
 ])
 def test_bad_values_exit_2_with_one_line_and_no_file(override, tmp_path):
     result = run_cli(*override.split(), f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)

@@ -84,9 +84,15 @@ class RadialDistributionConfig:
 
 
 @dataclass
+class ClustersConfig:
+    gap: Optional[float] = None
+
+
+@dataclass
 class ObserveConfig:
     radial_distribution: RadialDistributionConfig = field(
         default_factory=RadialDistributionConfig)
+    clusters: ClustersConfig = field(default_factory=ClustersConfig)
 
 
 @dataclass
@@ -222,6 +228,7 @@ def validate(cfg: Any) -> None:
         if not rdf.r_max > 1.0:
             raise ConfigError("observe.radial_distribution.r_max", rdf.r_max,
                               "greater than 1 (r in units of the contact distance 2⟨R⟩)")
+    _positive(c, "observe.clusters.gap", c.observe.clusters.gap, zero=True)
     if c.scene == "crater":
         p, b = c.projectile, c.bed
         if p is None or b is None:

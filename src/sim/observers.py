@@ -9,6 +9,8 @@ in Python between compiled chunks, never per event; a scene that names none pays
 """
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from sim.audit import kd_tree
 from sim.config import ConfigError
@@ -50,6 +52,43 @@ class RadialDistribution:
         return counts / ideal
 
 
+class Clusters:
+    """Clusters of disks closer than a gap: disks i and j are linked when
+    |r_i − r_j| < R_i + R_j + gap × 2⟨R⟩, and a cluster is a connected set of links (scipy's
+    connected components). The value is each disk's cluster label, numbered from 0 by
+    decreasing cluster size, so label 0 is the largest cluster; the clustering instability
+    of a cooling gas shows as the growth of that cluster.
+    """
+
+    name = "clusters"
+    unit = "1"
+    dtype = np.int32
+    axis = None
+
+    def __init__(self, gap, engine):
+        self.radius = np.asarray(engine.radius, dtype=np.float64)
+        self.reach = 2.0 * float(self.radius.max()) + gap * 2.0 * float(self.radius.mean())
+        self.gap = gap * 2.0 * float(self.radius.mean())
+        self.shape = (engine.n,)
+        self.description = (f"cluster label of each disk (0 = largest), disks linked below a "
+                            f"gap of {gap} × 2⟨R⟩")
+        self.box = engine.box
+        self.periodic = engine.periodic
+
+    def __call__(self, engine, position):
+        tree = kd_tree(position, self.box, self.periodic)
+        close = tree.sparse_distance_matrix(tree, self.reach, output_type="ndarray")
+        linked = close["v"] < self.radius[close["i"]] + self.radius[close["j"]] + self.gap
+        n = position.shape[0]
+        graph = coo_matrix((np.ones(linked.sum()), (close["i"][linked], close["j"][linked])),
+                           shape=(n, n))
+        _, labels = connected_components(graph, directed=False)
+        sizes = np.bincount(labels)
+        rank = np.empty_like(sizes)
+        rank[np.argsort(-sizes, kind="stable")] = np.arange(sizes.size)
+        return rank[labels].astype(np.int32)
+
+
 def from_config(cfg, engine):
     """The observers the scene's ``observe:`` section asks for, sized for ``engine``."""
     observers = []
@@ -62,4 +101,6 @@ def from_config(cfg, engine):
                               f"at most half the shorter box side, {limit:.4g} σ here "
                               f"(σ = 2⟨R⟩ = {sigma:.4g})")
         observers.append(RadialDistribution(int(rdf.bins), float(rdf.r_max), engine))
+    if cfg.observe.clusters.gap is not None:
+        observers.append(Clusters(float(cfg.observe.clusters.gap), engine))
     return observers
