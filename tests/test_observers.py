@@ -43,3 +43,22 @@ def test_clusters_of_a_solid_and_of_a_dilute_gas(overrides, largest, tmp_path):
     for size in sizes:
         assert np.all(np.diff(size) <= 0)  # numbered by decreasing size
         assert largest[0] <= size[0] / labels.shape[1] <= largest[1]
+
+
+def test_local_fields_add_up_to_the_whole_gas(tmp_path):
+    """The packing fractions of the cells average to the gas's φ exactly, and the cells' heat
+    adds up to the kinetic energy less the cells' flow, about one disk's share per cell."""
+    cfg = compose_config(["disks.packing_fraction=0.3", "observe.local_fields.cells=8",
+                          "stop.collisions=20000", "output.every_collisions=10000",
+                          "output.progress=false"])
+    with open_run(run(cfg, tmp_path)) as ds:
+        fields = ds["local_fields"]
+        assert fields.dims == ("time", "field", "y", "x") and fields.sizes["x"] == 8
+        n = ds.sizes["disk"]
+        position = ds["position"].isel(time=-1).values
+        energy = float(ds["kinetic_energy"].values[-1])
+        packing, temperature = fields.isel(time=-1).values
+    assert packing.mean() == pytest.approx(0.3, rel=1e-12)
+    counts = np.histogram2d(position[:, 1], position[:, 0], bins=8, range=[[0, 1], [0, 1]])[0]
+    heat = np.nansum(counts * temperature)
+    assert energy * (1.0 - 2.0 * 64 / n) < heat < energy

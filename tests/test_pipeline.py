@@ -129,6 +129,7 @@ def run_cli(*args, cwd):
     "observe.radial_distribution.bins=0",
     "observe.radial_distribution.bins=50 observe.radial_distribution.r_max=100",
     "observe.clusters.gap=-1",
+    "observe.local_fields.cells=0",
 ])
 def test_bad_values_exit_2_with_one_line_and_no_file(override, tmp_path):
     result = run_cli(*override.split(), f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)

@@ -6,8 +6,8 @@ Datasets that the figure stages read; nothing here simulates.
 (time, disk, axis) — read lazily from the HDF5 file, so only what is indexed is loaded —
 and the observables (``kinetic_energy``, ``kinetic_energy_by_species``, ``collisions``,
 ``wall_collisions``, ``dissipated_energy``, ``collision_virial``, and those of the scene's
-observers, e.g. ``radial_distribution`` over dim and coordinate ``r``, ``clusters`` over
-``disk``); per-disk coordinates
+observers, e.g. ``radial_distribution`` over ``r``, ``clusters`` over ``disk``,
+``local_fields`` over ``field``, ``y``, ``x``); per-disk coordinates
 ``radius``, ``mass``, ``species_id``; attributes: scene, seed, the resolved config (YAML), stop
 reason, box edges and boundary.
 
@@ -68,11 +68,10 @@ def open_run(path):
                 dims = ("time", "species")
             elif name in OBSERVABLES:
                 dims = ("time",)
-            else:  # an observer's: per disk, or over its abscissa stored beside its value
-                axis = next((k for k in group if k not in ("step", "time", "value")), "disk")
-                if axis != "disk":
-                    axes[axis] = group[axis][()]
-                dims = ("time", axis) if group["value"].ndim == 2 else ("time",)
+            else:  # an observer's: its dims as an attribute, coordinates beside its value
+                dims = ("time", *(str(d) for d in group.attrs["dims"]))
+                axes.update({k: group[k][()] for k in group
+                             if k not in ("step", "time", "value")})
             data[name] = xr.Variable(dims, group["value"][()],
                                      attrs={"unit": group["value"].attrs.get("unit", ""),
                                             "description": group.attrs.get("description", "")})

@@ -89,10 +89,16 @@ class ClustersConfig:
 
 
 @dataclass
+class LocalFieldsConfig:
+    cells: Optional[int] = None
+
+
+@dataclass
 class ObserveConfig:
     radial_distribution: RadialDistributionConfig = field(
         default_factory=RadialDistributionConfig)
     clusters: ClustersConfig = field(default_factory=ClustersConfig)
+    local_fields: LocalFieldsConfig = field(default_factory=LocalFieldsConfig)
 
 
 @dataclass
@@ -229,6 +235,9 @@ def validate(cfg: Any) -> None:
             raise ConfigError("observe.radial_distribution.r_max", rdf.r_max,
                               "greater than 1 (r in units of the contact distance 2⟨R⟩)")
     _positive(c, "observe.clusters.gap", c.observe.clusters.gap, zero=True)
+    cells = c.observe.local_fields.cells
+    if cells is not None and cells < 1:
+        raise ConfigError("observe.local_fields.cells", cells, "at least 1 cell along x")
     if c.scene == "crater":
         p, b = c.projectile, c.bed
         if p is None or b is None:

@@ -9,7 +9,8 @@ Layout written by :class:`RunWriter`:
   /observables/<name>         step, time, value — kinetic_energy, kinetic_energy_by_species
                               [T, S], collisions, wall_collisions, dissipated_energy,
                               collision_virial; and one per observer the scene asks for
-                              (:mod:`sim.observers`), with its abscissa beside ``value``
+                              (:mod:`sim.observers`): attribute ``dims``, coordinates
+                              beside ``value``
   /parameters                 config (resolved YAML), seed, versions, git commit, stop reason
   /checkpoint/{a,b}           the engine's full state at the last two snapshots, ``latest``
                               naming the complete one (for resume)
@@ -112,8 +113,8 @@ class RunWriter:
             group = observables.create_group(observer.name)
             _time_series(group, observer.shape, observer.dtype, observer.unit,
                          observer.description)
-            if observer.axis is not None:
-                name, values = observer.axis
+            group.attrs["dims"] = list(observer.dims)
+            for name, values in observer.coords.items():
                 group.create_dataset(name, data=values)
         p = f.create_group("parameters")
         for key, value in parameters.items():

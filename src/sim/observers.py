@@ -1,10 +1,11 @@
 """Observers: quantities computed from the state at every snapshot, chosen by the scene under
 ``observe:``, each written as its own H5MD observable ``/observables/<name>`` (step, time,
-value) beside the built-in ones, with its abscissa (if any) in ``/observables/<name>/<axis>``.
+value) beside the built-in ones; the names of the value's dimensions are the group's attribute
+``dims`` and their coordinates, where they have some, datasets beside ``value``.
 
 An observer has a ``name``, ``unit``, ``description``, the ``shape`` and ``dtype`` of one value,
-an ``axis`` (name, values) or None, and ``__call__(engine, position)`` giving the value at a
-snapshot from the engine and the positions float64[n, 2] at the snapshot time. Observers run
+its ``dims`` and ``coords`` ({dim: values}), and ``__call__(engine, position)`` giving the value
+at a snapshot from the engine and the positions float64[n, 2] at the snapshot time. Observers run
 in Python between compiled chunks, never per event; a scene that names none pays nothing.
 """
 
@@ -35,7 +36,8 @@ class RadialDistribution:
         self.edges = np.linspace(0.0, r_max * self.sigma, bins + 1)
         centres = 0.5 * (self.edges[1:] + self.edges[:-1]) / self.sigma
         self.shape = (bins,)
-        self.axis = ("r", centres)
+        self.dims = ("r",)
+        self.coords = {"r": centres}
         self.description = (f"g(r) over {bins} bins up to r = {r_max} σ, σ = 2⟨R⟩ = "
                             f"{self.sigma:.6g}; abscissa r (units of σ) in ./r")
         self.area = float(np.prod(engine.box))
@@ -63,7 +65,8 @@ class Clusters:
     name = "clusters"
     unit = "1"
     dtype = np.int32
-    axis = None
+    dims = ("disk",)
+    coords = {}
 
     def __init__(self, gap, engine):
         self.radius = np.asarray(engine.radius, dtype=np.float64)
@@ -89,6 +92,51 @@ class Clusters:
         return rank[labels].astype(np.int32)
 
 
+class LocalFields:
+    """Packing fraction and granular temperature on a grid of ``cells`` × ``cells_y`` cells: a
+    disk counts in the cell of its centre; the packing fraction is Σ πR² over the cell's area,
+    the temperature ⟨m |v − u|²⟩/2 over its disks in the frame of the cell's mass-weighted
+    mean velocity u (2D, k_B = 1; the collective flow of a cooling gas is not heat). Empty
+    cells hold NaN temperature. Value [2, y, x]: packing fraction, then temperature."""
+
+    name = "local_fields"
+    unit = "1 (packing fraction), energy (temperature)"
+    dtype = np.float64
+    dims = ("field", "y", "x")
+
+    def __init__(self, cells, engine):
+        lx, ly = (float(side) for side in engine.box)
+        self.cells = (cells, max(1, round(cells * ly / lx)))
+        self.width = (lx / self.cells[0], ly / self.cells[1])
+        self.shape = (2, self.cells[1], self.cells[0])
+        self.coords = {"x": (np.arange(self.cells[0]) + 0.5) * self.width[0],
+                       "y": (np.arange(self.cells[1]) + 0.5) * self.width[1]}
+        self.description = ("packing fraction (field 0) and granular temperature (field 1) on "
+                            f"{self.cells[0]} × {self.cells[1]} cells; cell centres in ./x, ./y")
+        self.disk_area = np.pi * np.asarray(engine.radius, dtype=np.float64) ** 2
+        self.mass = np.asarray(engine.mass, dtype=np.float64)
+
+    def __call__(self, engine, position):
+        nx, ny = self.cells
+        ix = np.clip((position[:, 0] / self.width[0]).astype(int), 0, nx - 1)
+        iy = np.clip((position[:, 1] / self.width[1]).astype(int), 0, ny - 1)
+        cell = iy * nx + ix
+        m, v = self.mass, engine.velocities()
+
+        def per_cell(weights):
+            return np.bincount(cell, weights=weights, minlength=nx * ny)
+
+        packing = per_cell(self.disk_area) / (self.width[0] * self.width[1])
+        mass = per_cell(m)
+        flow = np.stack([per_cell(m * v[:, a]) for a in range(2)], axis=1)
+        flow /= np.where(mass > 0.0, mass, 1.0)[:, None]
+        peculiar = 0.5 * m * np.sum((v - flow[cell]) ** 2, axis=1)
+        count = per_cell(np.ones_like(m))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            temperature = per_cell(peculiar) / count
+        return np.stack([packing, temperature]).reshape(self.shape)
+
+
 def from_config(cfg, engine):
     """The observers the scene's ``observe:`` section asks for, sized for ``engine``."""
     observers = []
@@ -103,4 +151,6 @@ def from_config(cfg, engine):
         observers.append(RadialDistribution(int(rdf.bins), float(rdf.r_max), engine))
     if cfg.observe.clusters.gap is not None:
         observers.append(Clusters(float(cfg.observe.clusters.gap), engine))
+    if cfg.observe.local_fields.cells is not None:
+        observers.append(LocalFields(int(cfg.observe.local_fields.cells), engine))
     return observers
