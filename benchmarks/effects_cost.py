@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from sim.engine import Boundary, Engine
-from sim.initial import fixed_speed, hexagonal_lattice
+from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing
 
 #: effect: (options of the base scene, absent, neutral, on); the species rows label half the
 #: disks 1 (see ``scene``).
@@ -59,7 +59,7 @@ def scene(state, options):
 
 def equilibrated(n, phi, seed=1):
     """Equal disks in the unit box with walls, 10 collisions per disk from a lattice."""
-    radius = float(np.sqrt(phi / (n * np.pi)))
+    radius = radius_for_packing(n, phi)
     engine = Engine(hexagonal_lattice(n, radius, seed=seed), fixed_speed(n, 1.0, seed=seed + 1),
                     radius)
     engine.run(collisions=10 * n)

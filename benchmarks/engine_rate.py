@@ -24,14 +24,14 @@ import time
 import numpy as np
 
 from sim.engine import Boundary, Engine
-from sim.initial import fixed_speed, hexagonal_lattice, random_sequential
+from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
 from sim.reference import ReferenceEngine
 
 FIRST_CALL = {"seconds": None}
 
 
 def equal_disks(n, phi, seed=1):
-    radius = float(np.sqrt(phi / (n * np.pi)))
+    radius = radius_for_packing(n, phi)
     if phi <= 0.3:
         position = random_sequential(np.full(n, radius), periodic=(True, True), seed=seed)
     else:

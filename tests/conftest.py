@@ -8,13 +8,13 @@ import pytest
 
 from sim.audit import outside_box, overlapping_pairs
 from sim.engine import Boundary, Engine
-from sim.initial import fixed_speed, hexagonal_lattice, random_sequential
+from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
 from sim.validation import table
 
 
 def gas(n, phi, periodic=(False, False), seed=0, speed=1.0, **engine_options):
     """An engine with n equal disks at packing fraction phi in the unit box, equal speeds."""
-    radius = np.sqrt(phi / (n * np.pi))
+    radius = radius_for_packing(n, phi)
     if phi <= 0.4:
         position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
     else:

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from conftest import assert_no_overlap, gas
 from sim.audit import overlapping_pairs
 from sim.engine import Boundary, Engine, InelasticCollapseError
-from sim.initial import fixed_speed, hexagonal_lattice, random_sequential
+from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
 
 MILLION = 1_000_000
 
@@ -38,7 +38,7 @@ def test_dense_solid_and_coexistence(phi):
 
 def test_mass_ratios_of_a_million_both_ways_in_one_box():
     n, phi = 500, 0.3
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     position = random_sequential(np.full(n, radius), seed=53)
     mass = np.ones(n)
     mass[0], mass[1] = 1e6, 1e-6
@@ -59,7 +59,7 @@ def test_one_disk_fifty_times_larger_than_the_rest():
 def test_one_fast_disk_in_a_nearly_frozen_gas():
     """Speed ratio 10⁸: the fast disk's energy spreads through the gas without a stall."""
     n, phi = 1000, 0.3
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     velocity = fixed_speed(n, 1e-8, seed=58)
     velocity[0] = [1.0, 0.3]
     engine = Engine(random_sequential(np.full(n, radius), seed=57), velocity, radius)
@@ -149,7 +149,7 @@ def test_a_hundred_million_collisions_of_a_thousand_disks():
        periodic=st.booleans(), restitution=st.sampled_from([None, 1.0]))
 def test_random_small_systems(n, phi, seed, periodic, restitution):
     """No overlap, energy kept (ξ = 1), momentum kept (periodic), time never runs back."""
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     boundary = Boundary(periodic=(periodic, periodic))
     position = hexagonal_lattice(n, radius, periodic=boundary.periodic, seed=seed)
     engine = Engine(position, fixed_speed(n, 1.0, seed=seed), radius, boundary=boundary,

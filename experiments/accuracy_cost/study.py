@@ -42,6 +42,7 @@ from sim.initial import (
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
+    radius_for_packing,
     random_sequential,
     remove_drift,
 )
@@ -134,7 +135,7 @@ def equilibration(quick):
     collisions per disk against its Maxwellian value 2 (equal speeds give 1); the error bar
     is the spread over ten groups of disks."""
     n, phi = 4000, 0.3
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     lengths = [0, 0.5, 1, 2, 4, 8] if quick else [0, 0.5, 1, 2, 4, 8, 16, 32]
     position = random_sequential(np.full(n, radius), periodic=(True, True), seed=9)
     error, bar, seconds = [], [], []
@@ -161,7 +162,7 @@ def tc_time(quick):
     does after about 8). Too short a t_c does not prevent the collapse; too long a one
     changes the cooling."""
     n, phi, xi = 1000, 0.6, 0.5
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
     mean_free_time = 1.0 / enskog_collision_frequency(n, 2.0 * radius, chi, 1.0)
     position = hexagonal_lattice(n, radius, seed=1)
@@ -360,7 +361,7 @@ def warm_up():
     two = np.arange(64) % 2
     equilibrated_gas(64, 0.3, 1)
     equilibrated_gas(64, 0.3, 1, mass=np.where(two == 1, 4.0, 1.0), species=two)
-    radius = math.sqrt(0.3 / (64 * math.pi))
+    radius = radius_for_packing(64, 0.3)
     Engine(hexagonal_lattice(64, radius), fixed_speed(64, 1.0), radius, restitution=0.5,
            wall_restitution=0.5, tc=1e-9).run(collisions=100)
 

@@ -26,8 +26,7 @@ import yaml
 from xarray.backends import BackendArray
 from xarray.core import indexing
 
-OBSERVABLES = ("kinetic_energy", "kinetic_energy_by_species", "collisions", "wall_collisions",
-               "dissipated_energy", "collision_virial")
+from sim.h5md import OBSERVABLES
 
 
 class _H5Array(BackendArray):

@@ -94,6 +94,11 @@ def _rsa(radius, lo, hi, box, periodic, rng, max_attempts):
     return position, -1
 
 
+def radius_for_packing(n, packing_fraction, area=1.0):
+    """Radius of n equal disks that cover ``packing_fraction`` of ``area``: φ = n π R²/A."""
+    return float(np.sqrt(packing_fraction * area / (n * np.pi)))
+
+
 def _region(region, box):
     if region is None:
         region = ((0.0, box[0]), (0.0, box[1]))

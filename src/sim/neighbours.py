@@ -16,7 +16,7 @@ everyone.
 Arrays (n disks):
   disks float64[n, DISK_COLUMNS] — the disk table of :mod:`sim.kinematics`, whose columns
   CX, CY hold the shell centre; delta float64[n], or one float when every shell has the same
-  radius (:func:`sim.state.per_disk`);
+  radius (:func:`sim.parameters.per_disk`);
   nb_start int32[n], nb_cap int32[n], nb_count int32[n], nb int32[sum(nb_cap)] — list of disk i
   is ``nb[nb_start[i] : nb_start[i] + nb_count[i]]``. When every list has the same capacity
   (no big disks), the compiled code gets that capacity instead of nb_start and nb_cap

@@ -17,6 +17,7 @@ from sim.initial import (
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
+    radius_for_packing,
     random_sequential,
     remove_drift,
 )
@@ -61,7 +62,7 @@ def _gas_radius(cfg):
     if d.packing_fraction is None:
         raise ConfigError("disks.packing_fraction", None,
                           "give disks.radius or disks.packing_fraction")
-    return float(np.sqrt(d.packing_fraction * area / (d.n * np.pi)))
+    return radius_for_packing(d.n, d.packing_fraction, area)
 
 
 def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):

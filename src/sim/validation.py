@@ -24,6 +24,7 @@ from sim.initial import (
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
+    radius_for_packing,
     random_sequential,
     remove_drift,
 )
@@ -76,7 +77,7 @@ def enskog_collision_frequency(n_density, sigma, chi, temperature, mass=1.0):
 def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None):
     """Elastic equal-size disks in the periodic unit box at T = 1 with zero total momentum,
     run ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     periodic = (True, True)
     mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,))
     if phi > 0.3:
@@ -147,7 +148,7 @@ def maxwell_boltzmann(n=4000, phi=0.3, warmup=20, snapshots=5, apart=10, seed=3)
     the run's temperature: the KS p-value (pass above 0.01; for one mass the energies give the
     same statistic) and the kurtosis ⟨v⁴⟩/⟨v²⟩² = 2 (four standard errors)."""
     started = time.perf_counter()
-    radius = math.sqrt(phi / (n * math.pi))
+    radius = radius_for_packing(n, phi)
     periodic = (True, True)
     position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
     velocity = remove_drift(fixed_speed(n, 1.0, seed=seed + 1), np.ones(n))
