@@ -30,7 +30,8 @@ def assert_no_overlap(engine, tolerance=1e-9):
     pairs, overlap = overlapping_pairs(position, engine.radius, engine.box, engine.periodic,
                                        tolerance)
     assert pairs.size == 0, f"overlapping pairs {pairs[:5].tolist()}, overlaps {overlap[:5]}"
-    escaped = outside_box(position, engine.radius, engine.box, engine.periodic, tolerance)
+    escaped = outside_box(position, engine.radius, engine.box, engine.periodic, tolerance,
+                          engine.wall_positions())
     assert escaped.size == 0, f"disks outside the box: {escaped[:5].tolist()}"
 
 

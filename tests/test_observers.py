@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from sim.analysis import open_run
+from sim.analysis import contacts, open_run, pressure_tensor
 from sim.figures.runs import compose_config
 from sim.runner import run
 from sim.validation import kolafa_rottner_z
@@ -62,3 +62,111 @@ def test_local_fields_add_up_to_the_whole_gas(tmp_path):
     counts = np.histogram2d(position[:, 1], position[:, 0], bins=8, range=[[0, 1], [0, 1]])[0]
     heat = np.nansum(counts * temperature)
     assert energy * (1.0 - 2.0 * 64 / n) < heat < energy
+
+
+def periodic_gas(tmp_path, *overrides):
+    cfg = compose_config(["box.boundary=periodic", "disks.packing_fraction=0.3",
+                          "disks.temperature=1.0", "disks.speed=null", *overrides,
+                          "output.progress=false"])
+    return open_run(run(cfg, tmp_path))
+
+
+def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
+    """The windings the loop counts agree with unwrapping snapshots so close in time that no
+    disk moves half a box between them; a lone disk is ballistic across many box lengths."""
+    from sim.engine import Boundary, Engine
+    from sim.initial import radius_for_packing, random_sequential
+
+    n = 200
+    radius = radius_for_packing(n, 0.2)
+    position = random_sequential(np.full(n, radius), periodic=(True, True), seed=4)
+    velocity = np.random.default_rng(5).normal(size=(n, 2)) * 10.0
+    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
+                    unwrap=True)
+    unwrapped = engine.positions(0.0)
+    previous = unwrapped.copy()
+    for t in np.arange(1, 400) * 2e-3:  # at most 0.02 × 10 × a few σ < L/2 per step
+        engine.run(time=t)
+        now = engine.positions(t)
+        unwrapped += (now - previous + 0.5) % 1.0 - 0.5
+        previous = now
+    np.testing.assert_allclose(engine.unwrapped_positions(t), unwrapped, rtol=0, atol=1e-9)
+    assert np.abs(unwrapped - position).max() > 2.0  # disks crossed the box several times
+
+    lone = Engine([[0.5, 0.5]], [[3.0, -4.0]], 0.01, boundary=Boundary(periodic=(True, True)),
+                  unwrap=True)
+    lone.run(time=10.0)
+    np.testing.assert_allclose(lone.unwrapped_positions(10.0), [[30.5, -39.5]], rtol=1e-14)
+
+
+def test_mean_squared_displacement_and_velocity_autocorrelation(tmp_path):
+    """Equilibrium gas at T = 1, φ = 0.3: the displacement is ballistic, ⟨v²⟩ t², well within
+    a mean free time and diffusive, 4 D t, after many; the velocity autocorrelation starts at
+    ⟨v²⟩ = 2T/m and has decayed to a few per cent after 10 mean free times; and its time
+    integral up to there (Green–Kubo, 2D: D = ½ ∫ ⟨v(t)·v(0)⟩ dt) gives D within 10 % of the
+    MSD slope. (Single time origin: the late values scatter by about ⟨v²⟩/√N.)"""
+    with periodic_gas(tmp_path, "observe.mean_squared_displacement=true",
+                      "observe.velocity_autocorrelation=true", "stop.collisions=null",
+                      "stop.time=0.4", "output.every_collisions=null",
+                      "output.every_time=0.0005") as ds:
+        msd = ds["mean_squared_displacement"].sel(species=0).values
+        vacf = ds["velocity_autocorrelation"].sel(species=0).values
+        time = ds["time"].values
+        v = ds["velocity"].values
+        v0_squared = float(np.mean(np.sum(v[0] ** 2, axis=1)))
+        np.testing.assert_allclose(vacf, np.mean(np.sum(v * v[0], axis=2), axis=1),
+                                   rtol=1e-12)
+        collisions = ds["collisions"].values
+    mean_free_time = 2000 * time[-1] / (2 * collisions[-1])
+    assert time[1] < 0.1 * mean_free_time
+    assert msd[1] / (v0_squared * time[1] ** 2) == pytest.approx(1.0, rel=0.03)
+    assert vacf[0] == pytest.approx(2.0, rel=0.05)
+    late = time > 10 * mean_free_time
+    assert abs(vacf[late].mean()) < 0.02 * vacf[0]
+    slope = np.polyfit(time[late], msd[late], 1)[0]
+    green_kubo = 0.5 * np.trapezoid(vacf[~late], time[~late])
+    assert slope / 4.0 == pytest.approx(green_kubo, rel=0.1)
+
+
+def test_pressure_tensor_is_isotropic_and_its_trace_is_the_pressure(tmp_path):
+    """In an equilibrium gas P_xx = P_yy, P_xy = 0, and ½ (P_xx + P_yy) A/(N T) is Z from the
+    scalar collision virial (the trace of Σ r_a Δp_b is Σ r·Δp, to round-off)."""
+    with periodic_gas(tmp_path, "observe.pressure_tensor=true", "stop.collisions=400000",
+                      "output.every_collisions=20000") as ds:
+        tensor = ds["collision_virial_tensor"].values
+        np.testing.assert_allclose(tensor[:, 0, 0] + tensor[:, 1, 1], ds["collision_virial"],
+                                   rtol=1e-12)
+        pressure = pressure_tensor(ds).isel(time=slice(2, None)).mean("time").values
+        temperature = float(ds["kinetic_energy"].mean()) / ds.sizes["disk"]
+        virial = ds["collision_virial"].values
+        elapsed = ds["time"].values[-1] - ds["time"].values[2]
+        z_scalar = 1.0 + (virial[-1] - virial[2]) / (2.0 * ds.sizes["disk"] * temperature
+                                                     * elapsed)
+    z_tensor = 0.5 * (pressure[0, 0] + pressure[1, 1]) / (ds.sizes["disk"] * temperature)
+    assert z_tensor == pytest.approx(z_scalar, rel=0.01)
+    assert pressure[0, 0] == pytest.approx(pressure[1, 1], rel=0.03)
+    assert abs(pressure[0, 1]) < 0.03 * pressure[0, 0]
+
+
+def test_event_log_holds_every_contact(tmp_path):
+    """The log has one row per contact, in order; its dissipated energies add up to the
+    run's, and for equal disks Σ |Δp| σ over disk contacts is the collision virial."""
+    cfg = compose_config(["disks.n=500", "restitution.disk=0.8", "restitution.wall=0.9",
+                          "tc.time=1e-7", "observe.event_log=true", "stop.collisions=100000",
+                          "output.every_collisions=10000", "output.progress=false"])
+    path = run(cfg, tmp_path)
+    log = contacts(path)
+    with open_run(path) as ds:
+        events = int(ds["collisions"][-1] + ds["wall_collisions"][-1])
+        dissipated = float(ds["dissipated_energy"][-1])
+        virial = float(ds["collision_virial"][-1])
+        sigma = 2.0 * float(ds["radius"][0])
+    assert log.sizes["contact"] == events
+    np.testing.assert_array_equal(log["contact"], np.arange(1, events + 1))
+    assert np.all(np.diff(log["time"]) >= 0.0)
+    assert float(log["dissipated"].sum()) == pytest.approx(dissipated, rel=1e-12)
+    disk_contacts = log["partner"] >= 0
+    assert float((log["impulse"] * sigma).where(disk_contacts).sum()) == pytest.approx(
+        virial, rel=1e-9)
+    assert set(np.unique(log["partner"].where(~disk_contacts, drop=True))) <= {-1, -2, -3, -4}
+    assert int(log["disk"].max()) < 500

@@ -20,7 +20,9 @@ from sim.inspect import RunFileError, summary
 register()
 SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
 SHRINK = {"gas": ["disks.n=300"], "mixture": ["disks.n=300"], "cooling": ["disks.n=300"],
-          "crater": ["bed.n=400", "projectile.radius=0.02"]}
+          "driven": ["disks.n=300"], "vibrated_bed": ["bed.n=100"],
+          "crater": ["bed.n=400", "projectile.radius=0.02"],
+          "crater_gravity": ["bed.n=300", "bed.radius=0.012", "bed.settle_time=0.5"]}
 
 
 def compose_scene(name, *overrides):
@@ -50,12 +52,17 @@ def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
             assert f[f"observables/{name_}/value"].shape[0] == frames
         assert f["parameters"].attrs["stop_reason"] in ("collisions", "events", "time",
                                                         "energy_fraction", "no_events")
-        assert "scene: " + name in f["parameters"].attrs["config"]
-        energy = f["observables/kinetic_energy/value"][()]
-        lost = f["observables/dissipated_energy/value"][()]
-        np.testing.assert_allclose(energy + lost, energy[0], rtol=1e-10)
+        assert "scene: " + cfg.scene in f["parameters"].attrs["config"]
+        observables = {name_: f[f"observables/{name_}/value"][()] for name_ in
+                       ("kinetic_energy", "potential_energy", "dissipated_energy", "wall_work")}
+    # kinetic + potential + dissipated − work of the walls stays what it was
+    balance = (observables["kinetic_energy"] + observables["potential_energy"]
+               + observables["dissipated_energy"] - observables["wall_work"])
+    scale = max(observables["kinetic_energy"].max(), abs(observables["wall_work"]).max())
+    np.testing.assert_allclose(balance, balance[0], rtol=0, atol=1e-10 * scale)
     info = summary(path)
     assert info["n"] == n and info["snapshots"] == frames
+    assert info["energy_drift"] <= 1e-10
 
 
 def interrupted_at_the_fourth_snapshot(cfg, folder, monkeypatch, checkpoint_every_snapshot):
@@ -81,24 +88,38 @@ def interrupted_at_the_fourth_snapshot(cfg, folder, monkeypatch, checkpoint_ever
     return folder / "run.h5"
 
 
-def test_resume_continues_to_the_same_bits(tmp_path, monkeypatch):
-    cfg = compose_scene("gas", "stop.collisions=6000", "output.every_collisions=1000",
-                        "restitution.disk=0.9", "tc.time=1e-7")
+#: scenes resumed in the tests: a cooling gas, and a gas driven by thermal walls that logs
+#: every contact and observes unwrapped displacements and the pressure tensor
+RESUMED = {
+    "gas": ("gas", "restitution.disk=0.9", "tc.time=1e-7"),
+    "driven": ("driven", "observe.event_log=true", "observe.mean_squared_displacement=true",
+               "observe.pressure_tensor=true", "observe.velocity_autocorrelation=true"),
+}
+RESUMED_KEYS = ("particles/disks/position/value", "particles/disks/velocity/value",
+                "particles/disks/position/time", "observables/collisions/value",
+                "observables/dissipated_energy/value", "observables/wall_work/value")
+DRIVEN_KEYS = ("events/contacts", "observables/mean_squared_displacement/value",
+               "observables/collision_virial_tensor/value")
+
+
+@pytest.mark.parametrize("scene", sorted(RESUMED))
+def test_resume_continues_to_the_same_bits(scene, tmp_path, monkeypatch):
+    cfg = compose_scene(*RESUMED[scene], "stop.collisions=6000", "output.every_collisions=1000")
     (tmp_path / "whole").mkdir()
     whole = runner.run(cfg, tmp_path / "whole")
     cut = interrupted_at_the_fourth_snapshot(cfg, tmp_path / "cut", monkeypatch, True)
     assert summary(cut)["snapshots"] == 4
     runner.resume(cut)
     with h5py.File(whole, "r") as a, h5py.File(cut, "r") as b:
-        for key in ("particles/disks/position/value", "particles/disks/velocity/value",
-                    "particles/disks/position/time", "observables/collisions/value",
-                    "observables/dissipated_energy/value"):
+        for key in RESUMED_KEYS + (DRIVEN_KEYS if scene == "driven" else ()):
             np.testing.assert_array_equal(a[key][()], b[key][()], err_msg=key)
         assert b["parameters"].attrs["stop_reason"] == "collisions"
 
 
-def test_frames_buffered_after_a_checkpoint_are_cut_and_made_again(tmp_path, monkeypatch):
-    cfg = compose_scene("gas", "stop.collisions=6000", "output.every_collisions=1000")
+@pytest.mark.parametrize("scene", sorted(RESUMED))
+def test_frames_buffered_after_a_checkpoint_are_cut_and_made_again(scene, tmp_path,
+                                                                   monkeypatch):
+    cfg = compose_scene(*RESUMED[scene], "stop.collisions=6000", "output.every_collisions=1000")
     (tmp_path / "whole").mkdir()
     whole = runner.run(cfg, tmp_path / "whole")
     cut = interrupted_at_the_fourth_snapshot(cfg, tmp_path / "cut", monkeypatch, False)
@@ -107,7 +128,8 @@ def test_frames_buffered_after_a_checkpoint_are_cut_and_made_again(tmp_path, mon
         assert f["checkpoint"][f["checkpoint"].attrs["latest"]].attrs["snapshots"] == 1
     runner.resume(cut)
     with h5py.File(whole, "r") as a, h5py.File(cut, "r") as b:
-        for key in ("particles/disks/position/value", "observables/collisions/value"):
+        for key in ("particles/disks/position/value", "observables/collisions/value",
+                    *(DRIVEN_KEYS if scene == "driven" else ())):
             np.testing.assert_array_equal(a[key][()], b[key][()], err_msg=key)
 
 
@@ -130,6 +152,13 @@ def run_cli(*args, cwd):
     "observe.radial_distribution.bins=50 observe.radial_distribution.r_max=100",
     "observe.clusters.gap=-1",
     "observe.local_fields.cells=0",
+    "gravity=[0,-1,0]",
+    "gravity=[0,-1] box.boundary=periodic",
+    "walls.left.temperature=-1",
+    "walls.bottom.amplitude=0.01",
+    "walls.top.speed=-0.1 box.boundary=periodic",
+    "walls.middle.speed=1",
+    "scenario=crater bed.settle_time=1",
 ])
 def test_bad_values_exit_2_with_one_line_and_no_file(override, tmp_path):
     result = run_cli(*override.split(), f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)

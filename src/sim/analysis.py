@@ -178,9 +178,69 @@ def granular_temperatures(position, velocity, mass, species, box, cells=8):
 
 
 def at_last_snapshot(sweep, name):
-    """``sweep[name]`` at each run's own last snapshot (runs of a sweep differ in length)."""
-    last = sweep["time"].notnull().sum("snapshot") - 1
+    """``sweep[name]`` at each run's own last snapshot (runs of a sweep differ in length; the
+    shorter ones are padded with NaN, which ``time`` is not when the runs share their snapshot
+    times)."""
+    last = sweep["kinetic_energy"].notnull().sum("snapshot") - 1
     return sweep[name].isel(snapshot=last)
 
 
-__all__ = ["at_last_snapshot", "granular_temperatures", "open_run", "open_sweep"]
+def pressure_tensor(run):
+    """Pressure tensor between consecutive snapshots of a run that observed it
+    (``observe.pressure_tensor=true``): P_ab = (K̄_ab + ΔW_ab/Δt)/A, with K_ab = Σ m v_a v_b
+    averaged over the two ends of each interval and W_ab = Σ r_a Δp_b the cumulative collision
+    virial tensor (Allen & Tildesley, *Computer Simulation of Liquids*, 2nd ed., §2.4). In a
+    periodic box the pressure is (P_xx + P_yy)/2. Returns a DataArray (time, a, b), time the
+    end of each interval."""
+    area = float(np.prod(run.attrs["box"]))
+    kinetic = 0.5 * (run["kinetic_tensor"] + run["kinetic_tensor"].shift(time=-1))
+    rate = run["collision_virial_tensor"].diff("time", label="upper") / run["time"].diff(
+        "time", label="upper")
+    tensor = (kinetic.isel(time=slice(None, -1)).values + rate.values) / area
+    return xr.DataArray(tensor, dims=("time", "a", "b"),
+                        coords={"time": rate["time"].values, "a": [0, 1], "b": [0, 1]},
+                        attrs={"unit": "energy/area"})
+
+
+def velocity_autocorrelation(run, max_lag):
+    """⟨v(t₀ + τ)·v(t₀)⟩ per species, averaged over every snapshot as time origin t₀, for lags
+    of 0 … ``max_lag`` snapshots. Snapshots must be evenly spaced in time (``output.every_time``).
+    Returns a DataArray (lag, species) with coordinate ``lag_time``."""
+    time = run["time"].values
+    steps = np.diff(time)
+    if steps.size and not np.allclose(steps, steps[0], rtol=1e-9, atol=0.0):
+        raise ValueError("velocity_autocorrelation needs snapshots evenly spaced in time "
+                         "(output.every_time)")
+    velocity = run["velocity"].values
+    species = run["species_id"].values
+    n_species = run.sizes["species"]
+    count = np.bincount(species, minlength=n_species)
+    lags = np.arange(min(max_lag, time.size - 1) + 1)
+    out = np.empty((lags.size, n_species))
+    for k, lag in enumerate(lags):
+        products = np.sum(velocity[lag:] * velocity[:time.size - lag], axis=2).mean(axis=0)
+        out[k] = np.bincount(species, weights=products, minlength=n_species) / count
+    return xr.DataArray(out, dims=("lag", "species"),
+                        coords={"lag": lags, "lag_time": ("lag", lags * (steps[0] if steps.size
+                                                                         else 0.0)),
+                                "species": np.arange(n_species)},
+                        attrs={"unit": "length²/time²"})
+
+
+def contacts(path):
+    """The event log of a run (``observe.event_log=true``) as a Dataset over ``contact``:
+    time, disk, partner (−1 − wall for wall contacts), impulse, dissipated."""
+    with h5py.File(path, "r") as f:
+        if "events/contacts" not in f:
+            raise KeyError(f"{path} has no event log: run the scene with observe.event_log=true")
+        rows = f["events/contacts"][()]
+    return xr.Dataset({"time": ("contact", rows[:, 0]),
+                       "disk": ("contact", rows[:, 1].astype(np.int64)),
+                       "partner": ("contact", rows[:, 2].astype(np.int64)),
+                       "impulse": ("contact", rows[:, 3]),
+                       "dissipated": ("contact", rows[:, 4])},
+                      coords={"contact": rows[:, 5].astype(np.int64)})
+
+
+__all__ = ["at_last_snapshot", "contacts", "granular_temperatures", "open_run", "open_sweep",
+           "pressure_tensor", "velocity_autocorrelation"]

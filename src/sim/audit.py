@@ -41,14 +41,19 @@ def overlapping_pairs(position, radius, box=(1.0, 1.0), periodic=(False, False),
     return pairs[bad], 1.0 - distance[bad] / sigma[bad]
 
 
-def outside_box(position, radius, box=(1.0, 1.0), periodic=(False, False), tolerance=1e-9):
-    """Indices of disks that poke through a wall by more than ``tolerance`` × radius."""
+def outside_box(position, radius, box=(1.0, 1.0), periodic=(False, False), tolerance=1e-9,
+                walls=None):
+    """Indices of disks that poke through a wall by more than ``tolerance`` × radius. The
+    walls sit at ``walls`` = (left, right, bottom, top) when they move
+    (:meth:`sim.engine.Engine.wall_positions`), else at the box edges."""
+    if walls is None:
+        walls = (0.0, box[0], 0.0, box[1])
     position = np.asarray(position, dtype=np.float64)
     radius = np.broadcast_to(np.asarray(radius, dtype=np.float64), (position.shape[0],))
     bad = np.zeros(position.shape[0], dtype=bool)
     for axis in range(2):
         if not periodic[axis]:
             slack = tolerance * radius
-            bad |= position[:, axis] - radius < -slack
-            bad |= position[:, axis] + radius > box[axis] + slack
+            bad |= position[:, axis] - radius < walls[2 * axis] - slack
+            bad |= position[:, axis] + radius > walls[2 * axis + 1] + slack
     return np.flatnonzero(bad)

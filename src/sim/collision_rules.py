@@ -6,14 +6,16 @@ with unit normal n = r_ij/|r_ij|, normal relative speed v_n = (v_i - v_j)·n < 0
 conserved and the kinetic energy falls by exactly (1 - ξ²) μ v_n²/2. The collision virial
 r_ij·Δp_i = -(1 + ξ) μ v_n |r_ij| enters the pressure.
 
-Wall: v_n' = -ξ_w v_n, v_t' = v_t; the energy lost is (1 - ξ_w²) m v_n²/2.
+Wall: v_n' = -ξ_w v_n, v_t' = v_t, in the frame of the wall (:mod:`sim.walls`); the energy
+lost is (1 - ξ_w²) m v_n²/2.
 
 TC model (Luding & McNamara, Granular Matter 1, 113 (1998)): a contact is elastic when either
 partner touched anything — disk or wall — less than ``t_c`` ago. Wall contacts count, so a
 disk trapped between a wall and its neighbours cannot collapse against the wall either.
 
-Each function returns ``(dissipated energy, virial term)`` and updates velocities in place in
-the disk table ``disks`` (columns in :mod:`sim.kinematics`); masses are passed as values.
+:func:`collide_disks` returns ``(dissipated energy, virial term)`` and updates velocities in
+place in the disk table ``disks`` (columns in :mod:`sim.kinematics`); masses are passed as
+values.
 """
 
 import math
@@ -49,14 +51,3 @@ def collide_disks(i, j, rx, ry, xi, disks, m_i, m_j):
     disks[j, VX] += dv_j * nx
     disks[j, VY] += dv_j * ny
     return 0.5 * (1.0 - xi * xi) * mu * v_n * v_n, -(1.0 + xi) * mu * v_n * r
-
-
-@njit(cache=True, inline="always")
-def reflect_from_wall(i, axis, xi_wall, disks, m):
-    """Reverse the normal velocity of disk i (mass m) at a wall normal to ``axis``.
-
-    Returns (energy dissipated, momentum given to the wall along the axis).
-    """
-    v_n = disks[i, VX + axis]
-    disks[i, VX + axis] = -xi_wall * v_n
-    return 0.5 * (1.0 - xi_wall * xi_wall) * m * v_n * v_n, m * (1.0 + xi_wall) * v_n

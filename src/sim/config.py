@@ -16,7 +16,8 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from sim.initial import RSA_JAMMING
 
-SCENES = ("single_disk", "two_disks", "scattering", "gas", "mixture", "crater", "cooling")
+SCENES = ("single_disk", "two_disks", "scattering", "gas", "mixture", "crater", "cooling",
+          "driven", "vibrated_bed")
 
 
 class ConfigError(ValueError):
@@ -52,6 +53,22 @@ class DisksConfig:
 class RestitutionConfig:
     disk: float = 1.0
     wall: float = 1.0
+
+
+@dataclass
+class WallConfig:
+    temperature: Optional[float] = None
+    speed: float = 0.0
+    amplitude: float = 0.0
+    frequency: float = 0.0
+
+
+@dataclass
+class WallsConfig:
+    left: WallConfig = field(default_factory=WallConfig)
+    right: WallConfig = field(default_factory=WallConfig)
+    bottom: WallConfig = field(default_factory=WallConfig)
+    top: WallConfig = field(default_factory=WallConfig)
 
 
 @dataclass
@@ -99,6 +116,10 @@ class ObserveConfig:
         default_factory=RadialDistributionConfig)
     clusters: ClustersConfig = field(default_factory=ClustersConfig)
     local_fields: LocalFieldsConfig = field(default_factory=LocalFieldsConfig)
+    mean_squared_displacement: bool = False
+    velocity_autocorrelation: bool = False
+    pressure_tensor: bool = False
+    event_log: bool = False
 
 
 @dataclass
@@ -115,6 +136,7 @@ class BedConfig:
     radius: float = 0.0045
     mass: float = 1.0
     height: float = 0.5
+    settle_time: Optional[float] = None
 
 
 @dataclass
@@ -144,6 +166,8 @@ class SimConfig:
     disks: DisksConfig = field(default_factory=DisksConfig)
     restitution: RestitutionConfig = field(default_factory=RestitutionConfig)
     tc: TCConfig = field(default_factory=TCConfig)
+    gravity: list = field(default_factory=lambda: [0.0, 0.0])
+    walls: WallsConfig = field(default_factory=WallsConfig)
     stop: StopConfig = field(default_factory=StopConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
     observe: ObserveConfig = field(default_factory=ObserveConfig)
@@ -172,6 +196,49 @@ def _positive(cfg, key, value, allow_none=True, zero=False):
 def _within(key, value, low, high, text):
     if value is not None and not low <= value <= high:
         raise ConfigError(key, value, text)
+
+
+def _validate_gravity_and_walls(c):
+    g = list(c.gravity)
+    if len(g) != 2 or not all(math.isfinite(x) for x in g):
+        raise ConfigError("gravity", g, "two finite numbers [gx, gy] (acceleration; [0, 0] = "
+                          "off)")
+    periodic = c.box.boundary == "periodic"
+    if periodic and any(g):
+        raise ConfigError("gravity", g, "[0, 0] in a periodic box, where nothing stops the "
+                          "fall: use box.boundary=walls")
+    for name in ("left", "right", "bottom", "top"):
+        wall = c.walls[name]
+        key = f"walls.{name}"
+        _positive(c, f"{key}.temperature", wall.temperature)
+        _positive(c, f"{key}.amplitude", wall.amplitude, allow_none=False, zero=True)
+        _positive(c, f"{key}.frequency", wall.frequency, allow_none=False, zero=True)
+        if not math.isfinite(wall.speed):
+            raise ConfigError(f"{key}.speed", wall.speed, "a finite speed")
+        moves = wall.speed != 0.0 or wall.amplitude != 0.0 or wall.temperature is not None
+        if moves and periodic:
+            raise ConfigError(f"{key}", OmegaConf.to_container(wall),
+                              "thermal or moving walls need box.boundary=walls")
+        if wall.amplitude > 0.0 and wall.frequency == 0.0:
+            raise ConfigError(f"{key}.frequency", wall.frequency,
+                              "an angular frequency > 0 for a wall with an amplitude")
+
+
+def _validate_bed(c):
+    b = c.bed
+    if b is None:
+        raise ConfigError("scene", c.scene, f"the {c.scene} scene needs a bed")
+    _positive(c, "bed.radius", b.radius, allow_none=False)
+    _positive(c, "bed.mass", b.mass, allow_none=False)
+    if b.n < 1:
+        raise ConfigError("bed.n", b.n, "at least 1 disk")
+    lx, ly = c.box.size
+    _within("bed.height", b.height, 1e-12, ly, f"between 0 and the box height {ly}")
+    bed_phi = b.n * math.pi * b.radius**2 / (lx * b.height)
+    if bed_phi > 0.85:
+        raise ConfigError("bed.n", b.n, f"at most a packing fraction of 0.85 in the bed "
+                          f"region (this is {bed_phi:.3f}): fewer or smaller bed disks, or "
+                          f"a higher bed.height")
 
 
 def validate(cfg: Any) -> None:
@@ -211,6 +278,7 @@ def validate(cfg: Any) -> None:
     _within("restitution.disk", c.restitution.disk, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
     _within("restitution.wall", c.restitution.wall, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
     _positive(c, "tc.time", c.tc.time, zero=True)
+    _validate_gravity_and_walls(c)
     s = c.stop
     for key in ("collisions", "events", "time", "wall_seconds"):
         _positive(c, f"stop.{key}", s[key])
@@ -238,32 +306,28 @@ def validate(cfg: Any) -> None:
     cells = c.observe.local_fields.cells
     if cells is not None and cells < 1:
         raise ConfigError("observe.local_fields.cells", cells, "at least 1 cell along x")
+    if c.scene in ("crater", "vibrated_bed"):
+        _validate_bed(c)
     if c.scene == "crater":
         p, b = c.projectile, c.bed
-        if p is None or b is None:
+        _positive(c, "bed.settle_time", b.settle_time)
+        if b.settle_time is not None and not any(c.gravity):
+            raise ConfigError("bed.settle_time", b.settle_time,
+                              "null without gravity (nothing settles); set gravity=[0,-1]")
+        if p is None:
             raise ConfigError("scene", c.scene, "the crater scene needs projectile and bed")
         _positive(c, "projectile.radius", p.radius, allow_none=False)
         _positive(c, "projectile.speed", p.speed, zero=True, allow_none=False)
         _positive(c, "projectile.mass", p.mass)
-        _positive(c, "bed.radius", b.radius, allow_none=False)
-        _positive(c, "bed.mass", b.mass, allow_none=False)
-        if b.n < 1:
-            raise ConfigError("bed.n", b.n, "at least 1 disk")
         lx, ly = c.box.size
         x, y = p.position
         if not (p.radius <= x <= lx - p.radius and p.radius <= y <= ly - p.radius):
             raise ConfigError("projectile.position", list(p.position),
                               f"inside the box, at least projectile.radius={p.radius} from "
                               f"every wall")
-        if y - p.radius < b.height:
+        if y - p.radius < b.height and b.settle_time is None:
             raise ConfigError("projectile.position", list(p.position),
                               f"above the bed (bed.height={b.height}) by at least its radius")
-        _within("bed.height", b.height, 1e-12, ly, f"between 0 and the box height {ly}")
-        bed_phi = b.n * math.pi * b.radius**2 / (lx * b.height)
-        if bed_phi > 0.85:
-            raise ConfigError("bed.n", b.n, f"at most a packing fraction of 0.85 in the bed "
-                              f"region (this is {bed_phi:.3f}): fewer or smaller bed disks, or "
-                              f"a higher bed.height")
     if c.scene == "mixture":
         m = c.mixture
         if m is None or len(m.masses) != len(m.fractions) or len(m.masses) < 1:

@@ -19,10 +19,13 @@ import numpy as np
 
 from sim import event_loop as loop
 from sim.event_queue import build_queue, empty_queue
-from sim.kinematics import RADIUS, VX, VY, X, Y
+from sim.gravity import gravity_vector, potential_energy
+from sim.kinematics import RADIUS, T_OWN, VX, VY, X, Y
 from sim.neighbours import build_all_neighbours, grow_lists, list_starts
 from sim.parameters import common_value
+from sim.recorders import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
 from sim.state import DiskArrays, disk_table
+from sim.walls import wall_motion, wall_state, wall_temperature
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
 #: φ = 0.5 and about 4.6 at φ = 0.1); interpolated linearly between the points.
@@ -44,6 +47,10 @@ class StalledError(RuntimeError):
     """Events keep arriving without the clock advancing: a numerical breakdown."""
 
 
+class ClosedBoxError(RuntimeError):
+    """Moving walls have squeezed the disks to jamming, or closed the box."""
+
+
 class InelasticCollapseError(RuntimeError):
     """Inelastic collapse: a few disks collide infinitely often in finite time."""
 
@@ -60,12 +67,44 @@ class InelasticCollapseError(RuntimeError):
         )
 
 
+#: wall numbers of :mod:`sim.walls` by name
+WALLS = {"left": 0, "right": 1, "bottom": 2, "top": 3}
+
+
 @dataclass(frozen=True)
 class Boundary:
     """Box [0, Lx] × [0, Ly]; each axis has hard walls or is periodic."""
 
     size: tuple = (1.0, 1.0)
     periodic: tuple = (False, False)
+
+
+#: A piston (a wall moving at constant speed) that has raised the kinetic energy this many
+#: times above max(initial energy, N m U²) has jammed the disks against the opposite wall:
+#: driven at constant speed, their collision rate and energy diverge at a finite time.
+PISTON_ENERGY_LIMIT = 1e6
+
+
+def _closing_time(motion, box, periodic, largest_radius):
+    """The absolute time at which moving walls could come closer to the opposite wall than
+    the largest disk diameter (inf when they never do): the gap along each walled axis is at
+    least L + (U_high − U_low) t − A_low − A_high."""
+    if motion is None:
+        return math.inf
+    closing = math.inf
+    for axis in range(2):
+        if periodic[axis]:
+            continue
+        low, high = motion[2 * axis], motion[2 * axis + 1]
+        room = box[axis] - low[1] - high[1] - 2.0 * largest_radius
+        if room <= 0.0:
+            raise ValueError(f"the walls of axis {'xy'[axis]} oscillate with amplitudes "
+                             f"{low[1]} and {high[1]} in a box {box[axis]} wide: they would "
+                             f"crush disks of radius {largest_radius}")
+        rate = low[0] - high[0]
+        if rate > 0.0:
+            closing = min(closing, room / rate)
+    return closing
 
 
 def shell_ratio(packing_fraction):
@@ -103,6 +142,17 @@ class Engine:
     shell : neighbour-shell diameter r_n/σ (default from the packing fraction)
     list_capacity : initial slots per neighbour list of an ordinary disk (default from the
         expected number of neighbours); full lists grow on demand
+    gravity : [gx, gy] uniform acceleration (:mod:`sim.gravity`); None or zero = off
+    walls : {"left" | "right" | "bottom" | "top": {"temperature": T_w, "speed": U,
+        "amplitude": A, "frequency": ω}} — thermal, moving and vibrating walls
+        (:mod:`sim.walls`); absent keys keep the wall hard and still
+    seed : keys the random draws of thermal walls (same seed, same bits)
+    unwrap : count periodic windings, for :meth:`unwrapped_positions` (mean squared
+        displacements)
+    pressure_tensor : accumulate the collision virial tensor Σ r_a Δp_b
+        (:attr:`virial_tensor`)
+    event_log : rows buffered for the log of every contact (:meth:`take_event_log`); None =
+        no log
     collapse_interval, collapse_streak : inelastic-collapse detector: more than
         ``collapse_streak`` consecutive dissipative contacts of one disk, each within
         ``collapse_interval`` of the previous one. The default interval is 1e-6 of the time
@@ -113,7 +163,9 @@ class Engine:
 
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
                  boundary=Boundary(), restitution=None, wall_restitution=None, tc=None,
-                 shell=None, collapse_interval=None, collapse_streak=10, list_capacity=None):
+                 gravity=None, walls=None, seed=0, unwrap=False, pressure_tensor=False,
+                 event_log=None, shell=None, collapse_interval=None, collapse_streak=10,
+                 list_capacity=None):
         position = np.array(position, dtype=np.float64, order="C")
         velocity = np.array(velocity, dtype=np.float64, order="C")
         n = position.shape[0]
@@ -159,6 +211,21 @@ class Engine:
             raise ValueError(f"tc must be ≥ 0 or None, got {tc}")
         dissipative = self.restitution is not None or self.wall_restitution is not None
         self.tc = float(tc) if (tc and dissipative) else None
+        self.gravity = gravity_vector(gravity)
+        if self.gravity is not None and np.any(self.gravity[periodic] != 0.0):
+            raise ValueError(f"gravity {self.gravity.tolist()} has a component along a periodic "
+                             f"axis, where nothing stops the fall; give it walls")
+        walls = {} if walls is None else dict(walls)
+        unknown = set(walls) - set(WALLS)
+        if unknown:
+            raise ValueError(f"unknown walls {sorted(unknown)}: use {', '.join(WALLS)}")
+        if any(periodic[WALLS[name] >> 1] for name, spec in walls.items() if spec):
+            raise ValueError(f"walls {walls} are given on a periodic axis, which has none")
+        by_number = {WALLS[name]: dict(spec) for name, spec in walls.items() if spec}
+        self.wall_motion = wall_motion(by_number, box)
+        self.wall_temperature = wall_temperature(by_number)
+        self.seed = int(seed)
+        self.closing_time = _closing_time(self.wall_motion, box, periodic, float(radius.max()))
 
         self.radius = radius
         self.mass = mass
@@ -167,6 +234,11 @@ class Engine:
         self.accumulators = np.zeros(loop.N_ACCUMULATORS)
         self.pair_collisions = np.zeros((self.n_species, self.n_species), dtype=np.int64)
         self.wall_impulse = np.zeros(4)
+        self.virial_tensor = np.zeros(3) if pressure_tensor else None
+        self.event_log = (None if event_log is None
+                          else np.zeros((max(int(event_log), 1), LOG_COLUMNS)))
+        self.log_fill = np.zeros(1, dtype=np.int64)
+        self._logged = []
         self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
         self.rebase_every = 16 * n + 1024
         self.reorder_every = (REORDER_EVENTS_PER_DISK * n if n >= REORDER_MIN_DISKS
@@ -178,6 +250,8 @@ class Engine:
                                   else float(collapse_interval))
         self.collapse_streak = int(collapse_streak)
         self._build(position, velocity, shell, list_capacity)
+        if unwrap:
+            self.disks.images = np.zeros((n, 2), dtype=np.int32)
 
     # -- construction ---------------------------------------------------------------------
     def _build(self, position, velocity, shell, list_capacity):
@@ -258,7 +332,7 @@ class Engine:
             self._grow_lists(full)
         loop.predict_all(0.0, d.table, shell_radius, d.coll_count, d.event_time,
                          d.event_partner, d.event_count, self._list_layout()[0], d.nb_count,
-                         d.nb, self.geometry, self.grid)
+                         d.nb, self.geometry, self.grid, self.gravity, self.wall_motion, 0.0)
         build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()
@@ -303,11 +377,16 @@ class Engine:
                 d.streak, d.event_time, d.event_partner, d.event_count, *d.queue,
                 *self._list_layout(), d.nb_count, d.nb,
                 d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
-                self.grid, self.restitution, self.wall_restitution, self.tc, self.counters,
+                self.grid, self.restitution, self.wall_restitution, self.tc, self.gravity,
+                self.wall_motion, self.wall_temperature, self.seed, d.images,
+                self.virial_tensor, self.event_log, self.log_fill, self.counters,
                 self.accumulators, self.pair_collisions, self.wall_impulse,
                 min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
                 dissipation_limit,
                 self.collapse_interval, self.collapse_streak, self.rebase_every)
+            self._drain_event_log()
+            if status == loop.STATUS_LOG_FULL:
+                continue
             if status == loop.STATUS_EVENT_LIMIT and self.counters[loop.EVENTS] == reorder_at:
                 self.reorder()
                 if reorder_at < max_events:
@@ -347,6 +426,8 @@ class Engine:
         max_contacts = big if events is None else int(events)
         max_collisions = big if collisions is None else int(collisions)
         t_stop = math.inf if time is None else float(time)
+        closing = t_stop > self.closing_time
+        t_stop = min(t_stop, self.closing_time)
         dissipation_limit = (math.inf if energy_fraction is None
                              else self.initial_energy * (1.0 - float(energy_fraction)))
         started = wallclock.perf_counter()
@@ -359,11 +440,32 @@ class Engine:
             status = self._run_chunk(chunk_end, max_contacts, max_collisions, t_stop,
                                      dissipation_limit)
             if status != loop.STATUS_EVENT_LIMIT:
+                if closing and status == loop.STATUS_TIME_REACHED:
+                    raise ClosedBoxError(
+                        f"at t = {self.closing_time:.6g} the moving walls come within the "
+                        f"largest disk diameter ({2 * self.radius.max():.6g}) of the opposite "
+                        f"wall: stop the run earlier (stop.time) or slow the piston")
                 return reasons[status]
+            self._check_piston()
             if wall_seconds is not None and wallclock.perf_counter() - started >= wall_seconds:
                 return "wall_seconds"
             if until is not None and until(self):
                 return "predicate"
+
+    def _check_piston(self):
+        """Raise :class:`ClosedBoxError` when a piston has jammed the disks (see
+        :data:`PISTON_ENERGY_LIMIT`); checked between chunks."""
+        if self.wall_motion is None or not np.any(self.wall_motion[:, 0]):
+            return
+        speed = float(np.abs(self.wall_motion[:, 0]).max())
+        scale = max(self.initial_energy, float(self.mass.sum()) * speed**2)
+        energy = self.kinetic_energy()
+        if energy > PISTON_ENERGY_LIMIT * scale:
+            raise ClosedBoxError(
+                f"at t = {self.time:.6g} the piston has jammed the disks: their kinetic energy "
+                f"{energy:.3g} is {energy / scale:.3g} times max(initial energy, N m U²), and "
+                f"a wall driven at constant speed makes it diverge; stop the run earlier "
+                f"(stop.time) or slow the piston")
 
     # -- observables ----------------------------------------------------------------------
     @property
@@ -404,10 +506,14 @@ class Engine:
         """Every array that evolves, by name: restoring it into an engine built from the same
         inputs continues the run to the same bits."""
         loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
-        state = {f"disks/{name}": value for name, value in vars(self.disks).items()}
+        self._drain_event_log()
+        state = {f"disks/{name}": value for name, value in vars(self.disks).items()
+                 if value is not None}
         state.update(counters=self.counters, accumulators=self.accumulators,
                      pair_collisions=self.pair_collisions, wall_impulse=self.wall_impulse,
                      initial_energy=np.array(self.initial_energy))
+        if self.virial_tensor is not None:
+            state["virial_tensor"] = self.virial_tensor
         return state
 
     def load_state_dict(self, state):
@@ -427,17 +533,40 @@ class Engine:
         out[self.disks.order] = values
         return out
 
+    def _relative_time(self, t):
+        return (self.accumulators[loop.T_NOW] if t is None
+                else float(t) - self.accumulators[loop.T_ORIGIN])
+
+    def _state(self, t):
+        return loop.state_at(self._relative_time(t), self.disks.table, self.geometry,
+                             self.grid, self.gravity)
+
     def positions(self, t=None):
         """Positions float64[n, 2] of every disk at absolute time ``t`` (default: the time of
         the last event); ``t`` must not precede the last event."""
-        t_rel = (self.accumulators[loop.T_NOW] if t is None
-                 else float(t) - self.accumulators[loop.T_ORIGIN])
-        d = self.disks
-        return self._user_order(loop.positions_at(t_rel, d.table, self.geometry, self.grid))
+        return self._user_order(self._state(t)[0])
 
-    def velocities(self):
-        """Velocities float64[n, 2] (constant between events)."""
-        return self._user_order(self.disks.table[:, VX:VY + 1])
+    def velocities(self, t=None):
+        """Velocities float64[n, 2] at absolute time ``t`` (default: the last event); they
+        change between events only under gravity."""
+        return self._user_order(self._state(t)[1])
+
+    def unwrapped_positions(self, t=None):
+        """Positions float64[n, 2] at time ``t`` continued across periodic boundaries
+        (r + windings · L), for mean squared displacements; needs ``unwrap=True``."""
+        if self.disks.images is None:
+            raise ValueError("unwrapped positions need an engine made with unwrap=True")
+        d = self.disks
+        dt = (self._relative_time(t) - d.table[:, T_OWN])[:, None]
+        acceleration = 0.0 if self.gravity is None else self.gravity
+        flown = (d.table[:, VX:VY + 1] + 0.5 * acceleration * dt) * dt
+        return self._user_order(d.table[:, X:Y + 1] + d.images * self.box + flown)
+
+    def wall_positions(self, t=None):
+        """Positions float64[4] of the walls (left, right, bottom, top) at absolute time t."""
+        t_abs = self.time if t is None else float(t)
+        return np.array([wall_state(w, t_abs, self.geometry, self.wall_motion)[0]
+                         for w in range(4)])
 
     def collisions_by_disk(self):
         """Contacts (disk and wall) of each disk so far: int64[n]."""
@@ -449,14 +578,50 @@ class Engine:
         d = self.disks
         return float(d.event_time.min() + self.accumulators[loop.T_ORIGIN])
 
-    def kinetic_energy_by_species(self):
+    def kinetic_energy_by_species(self, t=None):
+        """Σ m v²/2 per species at time t: float64[n_species]."""
         d = self.disks
-        return loop.kinetic_energy_by_species(d.table, d.mass, d.species, self.n_species)
+        energy = 0.5 * d.mass * np.sum(self._state(t)[1] ** 2, axis=1)
+        return np.bincount(d.species, weights=energy, minlength=self.n_species)
 
-    def kinetic_energy(self):
+    def kinetic_energy(self, t=None):
+        """Σ m v²/2 at time t (default: the last event)."""
         d = self.disks
-        return float(np.sum(0.5 * d.mass * np.sum(d.table[:, VX:VY + 1] ** 2, axis=1)))
+        return float(np.sum(0.5 * d.mass * np.sum(self._state(t)[1] ** 2, axis=1)))
 
-    def momentum(self):
+    def potential_energy(self, t=None):
+        """Σ −m g·r at time t (zero without gravity)."""
+        return potential_energy(self._state(t)[0], self.disks.mass, self.gravity)
+
+    @property
+    def wall_work(self):
+        """Work done on the disks by moving and thermal walls so far."""
+        return float(self.accumulators[loop.WALL_WORK])
+
+    def momentum(self, t=None):
         d = self.disks
-        return (d.mass[:, None] * d.table[:, VX:VY + 1]).sum(axis=0)
+        return (d.mass[:, None] * self._state(t)[1]).sum(axis=0)
+
+    # -- event log ------------------------------------------------------------------------
+    def _drain_event_log(self):
+        """Move the rows of the compiled log to :attr:`_logged`, disks renamed to the user's
+        numbering (the engine's own numbering changes when it reorders)."""
+        if self.event_log is None or self.log_fill[0] == 0:
+            return
+        rows = self.event_log[:self.log_fill[0]].copy()
+        order = self.disks.order
+        rows[:, LOG_DISK] = order[rows[:, LOG_DISK].astype(np.int64)]
+        partner = rows[:, LOG_PARTNER].astype(np.int64)
+        disk = partner >= 0
+        rows[disk, LOG_PARTNER] = order[partner[disk]]
+        self._logged.append(rows)
+        self.log_fill[0] = 0
+
+    def take_event_log(self):
+        """The contacts logged since the last call: float64[k, 6], columns as in
+        :mod:`sim.recorders` (disks in the user's numbering)."""
+        self._drain_event_log()
+        rows = (np.concatenate(self._logged) if self._logged
+                else np.zeros((0, LOG_COLUMNS)))
+        self._logged = []
+        return rows

@@ -13,18 +13,26 @@ events are re-predicted, never applied.
 
 Optional effects arrive as arguments that are either ``None`` or a value; numba compiles one
 loop per combination and removes the code of every effect that is ``None``:
-``restitution`` float64[s, s] per species pair, ``wall_restitution`` float, ``tc`` float.
+``restitution`` float64[s, s] per species pair, ``wall_restitution`` float, ``tc`` float;
+``gravity`` float64[2] (:mod:`sim.gravity`, :mod:`sim.flight`); wall ``motion`` float64[4, 3]
+and wall ``temperature`` float64[4] (:mod:`sim.walls`); winding counts ``images`` int32[n, 2]
+(:mod:`sim.flight`); ``virial_tensor`` float64[3] and ``event_log`` float64[capacity, 6]
+with ``log_fill`` int64[1] (:mod:`sim.recorders`).
 Likewise ``mass``, ``species`` and ``delta`` are arrays only when the disks differ in them, and
 otherwise one number (:func:`sim.parameters.per_disk`).
 
 The loop returns ``(status, disk)``; errors are codes, raised as exceptions by the caller.
 """
 
+import math
+
 import numpy as np
 from numba import njit
 
-from sim.collision_rules import collide_disks, reflect_from_wall
+from sim.collision_rules import collide_disks
 from sim.event_queue import build_queue, earliest, reschedule
+from sim.flight import displacement, fly, position_at, velocity_at
+from sim.gravity import shell_exit
 from sim.kinematics import (
     CX,
     CY,
@@ -37,12 +45,12 @@ from sim.kinematics import (
     Y,
     minimum_image,
     pair_contact_time,
-    shell_exit_time,
-    wall_contact_time,
     wrap,
 )
 from sim.neighbours import list_start, rebuild_neighbours
 from sim.parameters import per_disk
+from sim.recorders import add_virial_tensor, log_contact
+from sim.walls import contact_key, hit_wall, predict_wall_contact
 
 # event partners other than a disk
 NO_EVENT = -1
@@ -59,6 +67,7 @@ STATUS_TIME_REACHED = 3
 STATUS_ENERGY_REACHED = 4
 STATUS_NO_EVENTS = 5
 STATUS_CONTACT_LIMIT = 6
+STATUS_LOG_FULL = 7
 STATUS_COLLAPSE = -1
 STATUS_LIST_FULL = -2
 STATUS_STALLED = -3
@@ -77,37 +86,15 @@ T_NOW = 1  # time of the last event, relative to T_ORIGIN
 DISSIPATED_DISKS = 2
 DISSIPATED_WALLS = 3
 VIRIAL = 4  # Σ r_ij·Δp_i over disk contacts
-N_ACCUMULATORS = 5
-
-
-@njit(cache=True, inline="always")
-def advance(i, t, disks, geometry, grid):
-    """Move disk i along its straight path to time t."""
-    dt = t - disks[i, T_OWN]
-    disks[i, X] = wrap(disks[i, X] + disks[i, VX] * dt, geometry[0], grid[2] != 0)
-    disks[i, Y] = wrap(disks[i, Y] + disks[i, VY] * dt, geometry[1], grid[3] != 0)
-    disks[i, T_OWN] = t
-
-
-@njit(cache=True, _nrt=False, error_model="numpy")
-def hit_wall(i, wall, xi_wall, disks, m, geometry):
-    """Disk i (mass m, at the time of contact) touches ``wall`` (0 … 3: 2 axis + side): clamp it
-    inside the box against round-off and reflect it. Returns (energy dissipated, momentum
-    given to the wall)."""
-    axis = wall >> 1
-    lo = disks[i, RADIUS]
-    hi = geometry[axis] - disks[i, RADIUS]
-    if disks[i, X + axis] < lo:
-        disks[i, X + axis] = lo
-    elif disks[i, X + axis] > hi:
-        disks[i, X + axis] = hi
-    return reflect_from_wall(i, axis, xi_wall, disks, m)
+WALL_WORK = 5  # work done by moving and thermal walls on the disks
+N_ACCUMULATORS = 6
 
 
 @njit(cache=True, inline="always")
 def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
-            nb_count, nb, geometry, grid):
-    """Schedule the earliest event of disk i, which must be at time t already."""
+            nb_count, nb, geometry, grid, gravity, motion, t_origin):
+    """Schedule the earliest event of disk i, which must be at time t already (``t_origin``:
+    the absolute time of the clock's zero, which moving walls need)."""
     px = grid[2] != 0
     py = grid[3] != 0
     x = disks[i, X]
@@ -115,28 +102,29 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
     vx = disks[i, VX]
     vy = disks[i, VY]
     r_i = disks[i, RADIUS]
-    tau = shell_exit_time(minimum_image(x - disks[i, CX], geometry[0], px),
-                          minimum_image(y - disks[i, CY], geometry[1], py), vx, vy,
-                          per_disk(delta, i))
+    tau = shell_exit(minimum_image(x - disks[i, CX], geometry[0], px),
+                     minimum_image(y - disks[i, CY], geometry[1], py), vx, vy,
+                     per_disk(delta, i), gravity)
     partner = SHELL_EXIT
-    if not px:
-        tau_w, side = wall_contact_time(x, vx, r_i, geometry[0])
-        if tau_w < tau:
-            tau = tau_w
-            partner = WALL_X_LOW - side
-    if not py:
-        tau_w, side = wall_contact_time(y, vy, r_i, geometry[1])
-        if tau_w < tau:
-            tau = tau_w
-            partner = WALL_Y_LOW - side
+    for axis in range(2):
+        if grid[2 + axis] == 0:
+            tau_w, side = predict_wall_contact(axis, t_origin + t, disks[i, X + axis],
+                                               disks[i, VX + axis], r_i, geometry, gravity,
+                                               motion)
+            if tau_w < tau:
+                tau = tau_w
+                # a search near a vibrating wall that stopped short: predict again from there
+                partner = WALL_X_LOW - 2 * axis - side if side >= 0 else SHELL_EXIT
     start = list_start(nb_start, i)
     for k in range(start, start + nb_count[i]):
         j = nb[k]
         dt = t - disks[j, T_OWN]
-        vx_j = disks[j, VX]
-        vy_j = disks[j, VY]
-        rx = minimum_image(x - disks[j, X] - vx_j * dt, geometry[0], px)
-        ry = minimum_image(y - disks[j, Y] - vy_j * dt, geometry[1], py)
+        vx_j = velocity_at(j, 0, dt, disks, gravity)
+        vy_j = velocity_at(j, 1, dt, disks, gravity)
+        rx = minimum_image(x - disks[j, X] - displacement(j, 0, dt, disks, gravity),
+                           geometry[0], px)
+        ry = minimum_image(y - disks[j, Y] - displacement(j, 1, dt, disks, gravity),
+                           geometry[1], py)
         tau_ij = pair_contact_time(rx, ry, vx - vx_j, vy - vy_j, r_i + disks[j, RADIUS])
         if tau_ij < tau:
             tau = tau_ij
@@ -166,13 +154,13 @@ def count_all_contacts(coll_count, contacts):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links, list_head,
-                 calendar, block_rate, geometry, grid, accumulators):
+                 calendar, block_rate, geometry, grid, gravity, images, accumulators):
     """Bring every disk to the current time and restart the clock there (order-preserving);
     the event queue is rebuilt for the shifted times, and the contact counts are updated."""
     count_contacts(coll_count, contacts)
     t0 = accumulators[T_NOW]
     for i in range(disks.shape[0]):
-        advance(i, t0, disks, geometry, grid)
+        fly(i, t0, disks, geometry, grid, gravity, images)
         disks[i, T_OWN] = 0.0
         t_last[i] -= t0
         event_time[i] -= t0
@@ -185,7 +173,8 @@ def rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links, l
 def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak, event_time,
                event_partner, event_count, heap, links, list_head, calendar, block_rate,
                nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_prev, cell_of, big,
-               geometry, grid, restitution, wall_restitution, tc,
+               geometry, grid, restitution, wall_restitution, tc, gravity, motion, temperature,
+               seed, images, virial_tensor, event_log, log_fill,
                counters, accumulators, pair_collisions, wall_impulse,
                max_events, max_contacts, max_collisions, t_stop, dissipation_limit,
                collapse_dt, collapse_streak, rebase_every):
@@ -213,6 +202,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     dissipated_disks = accumulators[DISSIPATED_DISKS]
     dissipated_walls = accumulators[DISSIPATED_WALLS]
     virial_sum = accumulators[VIRIAL]
+    wall_work = accumulators[WALL_WORK]
+    log_full = False
     t_stop_rel = t_stop - accumulators[T_ORIGIN]
     events_to_rebase = rebase_every - events % rebase_every
     status = 0
@@ -233,6 +224,9 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         if dissipated_disks + dissipated_walls >= dissipation_limit:
             status = STATUS_ENERGY_REACHED
             break
+        if log_full:
+            status = STATUS_LOG_FULL
+            break
         i = earliest(heap, links, list_head, calendar, block_rate, event_time)
         t = event_time[i]
         if t > t_stop_rel:
@@ -251,13 +245,13 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
             stalled = 0
             t_previous = t
         partner = event_partner[i]
-        advance(i, t, disks, geometry, grid)
+        fly(i, t, disks, geometry, grid, gravity, images)
         j = partner  # the second disk to re-predict, when it is a disk contact
         if partner >= 0 and coll_count[j] != event_count[i]:
             stale_events += 1
             j = NO_EVENT
         elif partner >= 0:
-            advance(j, t, disks, geometry, grid)
+            fly(j, t, disks, geometry, grid, gravity, images)
             rx = minimum_image(disks[i, X] - disks[j, X], geometry[0], grid[2] != 0)
             ry = minimum_image(disks[i, Y] - disks[j, Y], geometry[1], grid[3] != 0)
             xi = 1.0
@@ -270,6 +264,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                                          per_disk(mass, j))
             dissipated_disks += lost
             virial_sum += virial
+            if virial_tensor is not None:
+                add_virial_tensor(virial_tensor, rx, ry, virial)
             s_i = per_disk(species, i)
             s_j = per_disk(species, j)
             if s_i <= s_j:
@@ -280,6 +276,10 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
             coll_count[j] += 1
             disk_collisions += 1
             events += 1
+            if event_log is not None:
+                log_full = log_contact(event_log, log_fill, accumulators[T_ORIGIN] + t, i, j,
+                                       virial / math.sqrt(rx * rx + ry * ry), lost,
+                                       disk_collisions + wall_collisions)
             if dissipative:
                 for d in (i, j):
                     streak[d] = streak[d] + 1 if (xi < 1.0 and t - t_last[d] < collapse_dt) else 0
@@ -306,12 +306,21 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                 if tc is not None:
                     if t - t_last[i] < tc:
                         xi_w = 1.0
-            lost, impulse = hit_wall(i, wall, xi_w, disks, per_disk(mass, i), geometry)
+            key = np.uint64(0)
+            if temperature is not None:
+                key = contact_key(seed, wall_collisions)
+            lost, impulse, work = hit_wall(i, wall, accumulators[T_ORIGIN] + t, xi_w, disks,
+                                           per_disk(mass, i), geometry, motion, temperature, key)
             dissipated_walls += lost
+            wall_work += work
             wall_impulse[wall] += impulse
             coll_count[i] += 1
             wall_collisions += 1
             events += 1
+            if event_log is not None:
+                log_full = log_contact(event_log, log_fill, accumulators[T_ORIGIN] + t, i,
+                                       -1 - wall, abs(impulse), lost,
+                                       disk_collisions + wall_collisions)
             if dissipative:
                 streak[i] = streak[i] + 1 if (xi_w < 1.0 and t - t_last[i] < collapse_dt) else 0
                 t_last[i] = t
@@ -324,7 +333,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         for k in range(1 if j < 0 else 2):
             moved = i if k == 0 else j
             predict(moved, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                    nb_start, nb_count, nb, geometry, grid)
+                    nb_start, nb_count, nb, geometry, grid, gravity, motion,
+                    accumulators[T_ORIGIN])
             reschedule(heap, links, list_head, calendar, block_rate, event_time, moved)
         if partner >= 0 and j < 0:
             continue  # a stale event is no event: the clock and the rebase count stay
@@ -333,7 +343,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         if events_to_rebase == 0:
             accumulators[T_NOW] = t_now
             rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links,
-                         list_head, calendar, block_rate, geometry, grid, accumulators)
+                         list_head, calendar, block_rate, geometry, grid, gravity, images,
+                         accumulators)
             t_now = 0.0
             t_stop_rel = t_stop - accumulators[T_ORIGIN]
             events_to_rebase = rebase_every
@@ -346,37 +357,33 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     accumulators[DISSIPATED_DISKS] = dissipated_disks
     accumulators[DISSIPATED_WALLS] = dissipated_walls
     accumulators[VIRIAL] = virial_sum
+    accumulators[WALL_WORK] = wall_work
     return status, culprit
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def predict_all(t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
-                nb_count, nb, geometry, grid):
+                nb_count, nb, geometry, grid, gravity, motion, t_origin):
     """Schedule the first event of every disk (all disks at time t)."""
     for i in range(disks.shape[0]):
         predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                nb_start, nb_count, nb, geometry, grid)
+                nb_start, nb_count, nb, geometry, grid, gravity, motion, t_origin)
 
 
 @njit(cache=True)
-def positions_at(t, disks, geometry, grid):
-    """Positions of all disks at time t (relative clock), without changing the state.
+def state_at(t, disks, geometry, grid, gravity):
+    """Positions and velocities of all disks at time t (relative clock), without changing
+    the state.
 
-    Returns float64[n, 2] wrapped into the periodic box.
+    Returns (position float64[n, 2] wrapped into the periodic box, velocity float64[n, 2]).
     """
     n = disks.shape[0]
-    out = np.empty((n, 2))
+    position = np.empty((n, 2))
+    velocity = np.empty((n, 2))
     for i in range(n):
         dt = t - disks[i, T_OWN]
-        out[i, 0] = wrap(disks[i, X] + disks[i, VX] * dt, geometry[0], grid[2] != 0)
-        out[i, 1] = wrap(disks[i, Y] + disks[i, VY] * dt, geometry[1], grid[3] != 0)
-    return out
-
-
-@njit(cache=True)
-def kinetic_energy_by_species(disks, mass, species, n_species):
-    """Σ m v²/2 per species: float64[n_species]."""
-    energy = np.zeros(n_species)
-    for i in range(disks.shape[0]):
-        energy[species[i]] += 0.5 * mass[i] * (disks[i, VX] ** 2 + disks[i, VY] ** 2)
-    return energy
+        for axis in range(2):
+            position[i, axis] = wrap(position_at(i, axis, dt, disks, gravity), geometry[axis],
+                                     grid[2 + axis] != 0)
+            velocity[i, axis] = velocity_at(i, axis, dt, disks, gravity)
+    return position, velocity

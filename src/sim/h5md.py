@@ -11,6 +11,9 @@ Layout written by :class:`RunWriter`:
                               collision_virial; and one per observer the scene asks for
                               (:mod:`sim.observers`): attribute ``dims``, coordinates
                               beside ``value``
+  /events/contacts            when the scene logs events (``observe.event_log``): one row per
+                              contact, columns time, disk, partner, impulse, dissipated,
+                              contact (:mod:`sim.recorders`), written at every flush
   /parameters                 config (resolved YAML), seed, versions, git commit, stop reason
   /checkpoint/{a,b}           the engine's full state at the last two snapshots, ``latest``
                               naming the complete one (for resume)
@@ -28,6 +31,7 @@ import h5py
 import numpy as np
 
 import sim
+from sim.recorders import LOG_COLUMNS, LOG_CONTACT
 
 OBSERVABLES = {
     "kinetic_energy": ("energy", "Σ m v²/2 over all disks"),
@@ -36,6 +40,8 @@ OBSERVABLES = {
     "wall_collisions": ("1", "cumulative disk–wall collisions"),
     "dissipated_energy": ("energy", "cumulative kinetic energy lost in contacts"),
     "collision_virial": ("length × momentum", "cumulative Σ r_ij·Δp_i over disk contacts"),
+    "potential_energy": ("energy", "Σ −m g·r (zero without gravity)"),
+    "wall_work": ("energy", "cumulative work of moving and thermal walls on the disks"),
 }
 
 
@@ -77,6 +83,7 @@ class RunWriter:
         self._last_checkpoint = -math.inf
         self._last_flush = -math.inf
         self._frames = []  # buffered (step, time, position, velocity, observables)
+        self._contacts = []  # buffered rows of the event log
         self.file = h5py.File(path, mode)
         if mode == "w":
             self._create(engine, parameters)
@@ -116,6 +123,17 @@ class RunWriter:
             group.attrs["dims"] = list(observer.dims)
             for name, values in observer.coords.items():
                 group.create_dataset(name, data=values)
+        if engine.event_log is not None:
+            contacts = f.create_dataset("events/contacts", shape=(0, LOG_COLUMNS),
+                                        maxshape=(None, LOG_COLUMNS), dtype=np.float64,
+                                        chunks=(4096, LOG_COLUMNS), compression="gzip",
+                                        compression_opts=1)
+            contacts.attrs["columns"] = ["time", "disk", "partner", "impulse", "dissipated",
+                                         "contact"]
+            contacts.attrs["description"] = (
+                "every contact: absolute time, disk, partner (a disk, or −1 − wall for walls "
+                "0 left, 1 right, 2 bottom, 3 top), normal impulse, energy dissipated, number "
+                "of contacts so far")
         p = f.create_group("parameters")
         for key, value in parameters.items():
             p.attrs[key] = value
@@ -128,16 +146,20 @@ class RunWriter:
         checkpointed, after a flush, when ``checkpoint`` is set or when
         ``checkpoint_seconds`` of wall time have passed since the last checkpoint."""
         t = engine.time if time is None else float(time)
-        observables = {"kinetic_energy": engine.kinetic_energy(),
-                       "kinetic_energy_by_species": engine.kinetic_energy_by_species(),
+        observables = {"kinetic_energy": engine.kinetic_energy(t),
+                       "kinetic_energy_by_species": engine.kinetic_energy_by_species(t),
                        "collisions": engine.collisions,
                        "wall_collisions": engine.wall_collisions,
                        "dissipated_energy": engine.dissipated_energy,
-                       "collision_virial": engine.virial}
-        position = engine.positions(t)
+                       "collision_virial": engine.virial,
+                       "potential_energy": engine.potential_energy(t),
+                       "wall_work": engine.wall_work}
+        position, velocity = engine.positions(t), engine.velocities(t)
         for observer in self.observers:
-            observables[observer.name] = observer(engine, position)
-        self._frames.append((engine.events, t, position, engine.velocities(), observables))
+            observables[observer.name] = observer(engine, t, position, velocity)
+        self._frames.append((engine.events, t, position, velocity, observables))
+        if engine.event_log is not None:
+            self._contacts.append(engine.take_event_log())
         now = wallclock.monotonic()
         if checkpoint or now - self._last_checkpoint >= self.checkpoint_seconds:
             self.flush()
@@ -160,6 +182,13 @@ class RunWriter:
                               [o[name] for o in observables])
             self._flushed_frames += len(self._frames)
             self._frames.clear()
+        if self._contacts:
+            rows = np.concatenate(self._contacts)
+            contacts = self.file["events/contacts"]
+            first = contacts.shape[0]
+            contacts.resize(first + rows.shape[0], axis=0)
+            contacts[first:] = rows
+            self._contacts.clear()
         self.file.flush()
         self._last_flush = wallclock.monotonic()
 
@@ -185,13 +214,18 @@ class RunWriter:
         self.file.flush()
         root.attrs["latest"] = slot
 
-    def truncate(self, snapshots):
-        """Drop frames written after the first ``snapshots`` ones (before resuming)."""
+    def truncate(self, snapshots, contacts):
+        """Drop frames written after the first ``snapshots`` ones, and logged contacts after
+        the ``contacts``-th (before resuming)."""
         for group in [self.file["particles/disks/position"], self.file["particles/disks/velocity"],
                       *self.file["observables"].values()]:
             for name in ("step", "time", "value"):
                 group[name].resize(snapshots, axis=0)
         self._flushed_frames = snapshots
+        if "events/contacts" in self.file:
+            log = self.file["events/contacts"]
+            kept = int(np.searchsorted(log[:, LOG_CONTACT], contacts, side="right"))
+            log.resize(kept, axis=0)
 
     def finish(self, reason):
         self.flush()

@@ -34,6 +34,8 @@ def summary(path):
             time = f["particles/disks/position/time"][()]
             energy = f["observables/kinetic_energy/value"][()]
             dissipated = f["observables/dissipated_energy/value"][()]
+            extra = {name: f[f"observables/{name}/value"][()] if name in f["observables"]
+                     else np.zeros_like(energy) for name in ("potential_energy", "wall_work")}
             collisions = f["observables/collisions/value"][()]
             n = f["particles/disks/radius"].shape[0]
             creator = f["h5md/creator"].attrs
@@ -56,9 +58,13 @@ def summary(path):
         except (KeyError, OSError, ValueError, yaml.YAMLError) as error:
             raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
     if energy.size:
-        # energy drift: E + dissipated should stay E0
-        balance = (energy + dissipated - energy[0]) / energy[0] if energy[0] else energy * 0
-        result["energy_drift"] = float(np.max(np.abs(balance)))
+        # energy balance: kinetic + potential + dissipated − work of the walls stays constant;
+        # the drift is measured against the largest energy the run has seen
+        mechanical = energy + extra["potential_energy"]
+        balance = mechanical + dissipated - extra["wall_work"] - mechanical[0]
+        scale = max(np.max(energy), np.max(np.abs(extra["wall_work"])), np.max(dissipated),
+                    np.finfo(float).tiny)
+        result["energy_drift"] = float(np.max(np.abs(balance)) / scale)
     return result
 
 

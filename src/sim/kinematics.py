@@ -127,3 +127,101 @@ def wall_contact_time(x, v, radius, length):
         tau = (length - radius - x) / v
         return (tau if tau > 0.0 else 0.0), 1
     return INF, -1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def first_contact_accelerated(h, v, a):
+    """First time τ ≥ 0 at which a gap h ≥ 0, opening at rate v and accelerating at a, closes:
+    the smaller non-negative root of h + v τ + a τ²/2 = 0, or inf when it never closes.
+
+    Cancellation-free (Numerical Recipes §5.6) with D = v² − 2 a h:
+      closing (v < 0):  τ = 2h/(√D − v), the root before any turning point; none when D < 0
+                        (the gap turns and opens again first);
+      opening (v ≥ 0):  τ = (v + √D)/(−a) when pulled back (a < 0), else never.
+    A gap found negative by round-off counts as closed: τ = 0 when closing, never in the past.
+    Used for wall contacts under gravity, where a disk flies on a parabola.
+    """
+    if h < 0.0:
+        h = 0.0
+    if a == 0.0:
+        return h / -v if v < 0.0 else INF
+    discriminant = v * v - 2.0 * a * h
+    if v < 0.0:
+        if discriminant < 0.0:
+            return INF
+        return 2.0 * h / (math.sqrt(discriminant) - v)
+    if a < 0.0:
+        return (v + math.sqrt(discriminant)) / -a
+    return INF
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def shell_exit_time_accelerated(dx, dy, vx, vy, g, delta):
+    """A time at or before the first exit of a disk on the parabola d + v τ + g_vec τ²/2
+    (|g_vec| = g) from the circle of radius δ about its shell centre (d: displacement from the
+    centre); never later than the true exit, which is the root of a quartic.
+
+    Two lower bounds, the larger is returned. With τ_l the exit of the straight path,
+    |d + v τ| ≤ δ − g τ_l²/2 up to the exit τ_s of the straight path from the shrunk circle of
+    that radius, and the bend adds at most g τ²/2 ≤ g τ_l²/2; and by the triangle inequality
+    |d| + |v| τ + g τ²/2 ≤ δ up to τ_t = 2(δ − |d|)/(|v| + √(|v|² + 2 g (δ − |d|))).
+    An early exit only rebuilds the list early: safe, and rare when g τ_l² ≪ δ.
+    """
+    tau_straight = shell_exit_time(dx, dy, vx, vy, delta)
+    tau_shrunk = 0.0
+    if tau_straight < INF:
+        shrunk = delta - 0.5 * g * tau_straight * tau_straight
+        if shrunk > 0.0:
+            tau_shrunk = shell_exit_time(dx, dy, vx, vy, shrunk)
+    room = delta - math.sqrt(dx * dx + dy * dy)
+    tau_triangle = 0.0
+    if room > 0.0:
+        speed = math.sqrt(vx * vx + vy * vy)
+        tau_triangle = 2.0 * room / (speed + math.sqrt(speed * speed + 2.0 * g * room))
+    return max(tau_shrunk, tau_triangle)
+
+
+#: Safe steps of :func:`first_contact_oscillating` before it hands back a point short of
+#: contact (the caller re-predicts from there): bounds the work of one prediction.
+OSCILLATING_STEPS = 64
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def first_contact_oscillating(h, v, a, amplitude, omega, phase, tolerance):
+    """First time τ ≥ 0 at which the gap f(τ) = h + v τ + a τ²/2 − A sin(ω τ + φ) closes:
+    a disk on a parabola meeting a wall that oscillates as A sin(ω t) (a vibrated floor).
+
+    The root is transcendental; it is approached from below by steps that can never pass it.
+    With |f''| ≤ K = |a| + A ω², the gap obeys f(τ + s) ≥ f + f' s − K s²/2, whose first root
+    s = 2f/(−f' + √(f'² + 2 K f)) is a safe step (Newton's step, to second order, near a simple
+    root). While the parabola stays above the band |f − q| ≤ A the exact quadratic root of
+    q − A (:func:`first_contact_accelerated`) is a safe step too, and the larger is taken.
+
+    Returns (τ, touching): touching when the gap is below ``tolerance`` (or negative, by
+    round-off) and closing (f' < 0); a gap that small but opening is stepped over as if it
+    were ``tolerance``. Otherwise τ is a point short of contact, reached after
+    ``OSCILLATING_STEPS`` steps (e.g. a grazing approach), from which the caller predicts
+    again. τ = inf when the disk never reaches the band.
+    """
+    curvature = abs(a) + amplitude * omega * omega
+    tau = 0.0
+    for _ in range(OSCILLATING_STEPS):
+        q = h + (v + 0.5 * a * tau) * tau
+        q_rate = v + a * tau
+        if q - amplitude > 0.0:
+            band = first_contact_accelerated(q - amplitude, q_rate, a)
+            if band == INF:
+                return INF, False
+        else:
+            band = 0.0
+        angle = omega * tau + phase
+        gap = q - amplitude * math.sin(angle)
+        rate = q_rate - amplitude * omega * math.cos(angle)
+        if gap <= tolerance and rate < 0.0:
+            return tau, True
+        gap = max(gap, tolerance)
+        step = 2.0 * gap / (-rate + math.sqrt(rate * rate + 2.0 * curvature * gap))
+        tau += max(step, band)
+        if tau == INF:
+            return INF, False
+    return tau, False

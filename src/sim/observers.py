@@ -4,9 +4,12 @@ value) beside the built-in ones; the names of the value's dimensions are the gro
 ``dims`` and their coordinates, where they have some, datasets beside ``value``.
 
 An observer has a ``name``, ``unit``, ``description``, the ``shape`` and ``dtype`` of one value,
-its ``dims`` and ``coords`` ({dim: values}), and ``__call__(engine, position)`` giving the value
-at a snapshot from the engine and the positions float64[n, 2] at the snapshot time. Observers run
-in Python between compiled chunks, never per event; a scene that names none pays nothing.
+its ``dims`` and ``coords`` ({dim: values}), and ``__call__(engine, t, position, velocity)``
+giving the value at a snapshot at absolute time t from the engine and the positions and
+velocities float64[n, 2] at that time. Observers run in Python between compiled chunks, never
+per event; a scene that names none pays nothing. Two need the compiled loop's help, which the
+engine gives only when asked: unwrapped positions (``unwrap``, :mod:`sim.flight`) and the
+collision virial tensor (``pressure_tensor``, :mod:`sim.recorders`).
 """
 
 import numpy as np
@@ -44,7 +47,7 @@ class RadialDistribution:
         self.box = engine.box
         self.periodic = engine.periodic
 
-    def __call__(self, engine, position):
+    def __call__(self, engine, t, position, velocity):
         tree = kd_tree(position, self.box, self.periodic)
         distance = tree.sparse_distance_matrix(tree, self.edges[-1], output_type="ndarray")
         distance = distance["v"][distance["i"] < distance["j"]]
@@ -78,7 +81,7 @@ class Clusters:
         self.box = engine.box
         self.periodic = engine.periodic
 
-    def __call__(self, engine, position):
+    def __call__(self, engine, t, position, velocity):
         tree = kd_tree(position, self.box, self.periodic)
         close = tree.sparse_distance_matrix(tree, self.reach, output_type="ndarray")
         linked = close["v"] < self.radius[close["i"]] + self.radius[close["j"]] + self.gap
@@ -116,12 +119,12 @@ class LocalFields:
         self.disk_area = np.pi * np.asarray(engine.radius, dtype=np.float64) ** 2
         self.mass = np.asarray(engine.mass, dtype=np.float64)
 
-    def __call__(self, engine, position):
+    def __call__(self, engine, t, position, velocity):
         nx, ny = self.cells
         ix = np.clip((position[:, 0] / self.width[0]).astype(int), 0, nx - 1)
         iy = np.clip((position[:, 1] / self.width[1]).astype(int), 0, ny - 1)
         cell = iy * nx + ix
-        m, v = self.mass, engine.velocities()
+        m, v = self.mass, velocity
 
         def per_cell(weights):
             return np.bincount(cell, weights=weights, minlength=nx * ny)
@@ -135,6 +138,90 @@ class LocalFields:
         with np.errstate(invalid="ignore", divide="ignore"):
             temperature = per_cell(peculiar) / count
         return np.stack([packing, temperature]).reshape(self.shape)
+
+
+class _BySpecies:
+    """Base of observers that average a per-disk quantity over each species."""
+
+    dtype = np.float64
+    dims = ("species",)
+
+    def __init__(self, engine):
+        self.species = engine.species
+        self.count = np.bincount(engine.species, minlength=engine.n_species)
+        self.shape = (engine.n_species,)
+        self.coords = {"species": np.arange(engine.n_species)}
+
+    def _mean(self, per_disk):
+        return np.bincount(self.species, weights=per_disk, minlength=self.shape[0]) / self.count
+
+
+class MeanSquaredDisplacement(_BySpecies):
+    """⟨|r(t) − r(0)|²⟩ per species from the start of the run, with positions continued across
+    periodic boundaries (Allen & Tildesley §8.3; in 2D, 4 D t at long times, D the
+    self-diffusion coefficient). The engine counts the windings in its loop
+    (``unwrap=True``)."""
+
+    name = "mean_squared_displacement"
+    unit = "length²"
+    description = "⟨|r(t) − r(0)|²⟩ per species, positions unwrapped across periodic sides"
+
+    def __init__(self, engine):
+        super().__init__(engine)
+        self.start = engine.unwrapped_positions(0.0)
+
+    def __call__(self, engine, t, position, velocity):
+        moved = engine.unwrapped_positions(t) - self.start
+        return self._mean(np.sum(moved**2, axis=1))
+
+
+class VelocityAutocorrelation(_BySpecies):
+    """⟨v(t)·v(0)⟩ per species, from the start of the run (Allen & Tildesley §2.7); its time
+    integral is 2 D in 2D. For averages over many time origins use
+    :func:`sim.analysis.velocity_autocorrelation` on the velocity snapshots."""
+
+    name = "velocity_autocorrelation"
+    unit = "length²/time²"
+    description = "⟨v(t)·v(0)⟩ per species, time origin at the start of the run"
+
+    def __init__(self, engine):
+        super().__init__(engine)
+        self.start = engine.velocities(0.0)
+
+    def __call__(self, engine, t, position, velocity):
+        return self._mean(np.sum(velocity * self.start, axis=1))
+
+
+class KineticTensor:
+    """Σ m v_a v_b over all disks: the kinetic part of the pressure tensor times the area."""
+
+    name = "kinetic_tensor"
+    unit = "energy"
+    description = "Σ m v_a v_b, [a, b]"
+    dtype = np.float64
+    shape = (2, 2)
+    dims = ("a", "b")
+    coords = {"a": np.array([0, 1]), "b": np.array([0, 1])}
+
+    def __init__(self, engine):
+        self.mass = engine.mass
+
+    def __call__(self, engine, t, position, velocity):
+        return np.einsum("i,ia,ib->ab", self.mass, velocity, velocity)
+
+
+class VirialTensor(KineticTensor):
+    """Σ r_a Δp_b over all disk contacts so far (:mod:`sim.recorders`): its growth over an
+    interval, divided by the interval, is the collisional part of the pressure tensor times
+    the area (:func:`sim.analysis.pressure_tensor`)."""
+
+    name = "collision_virial_tensor"
+    unit = "length × momentum"
+    description = "cumulative Σ r_a Δp_b over disk contacts, [a, b]"
+
+    def __call__(self, engine, t, position, velocity):
+        xx, xy, yy = engine.virial_tensor
+        return np.array([[xx, xy], [xy, yy]])
 
 
 def from_config(cfg, engine):
@@ -153,4 +240,10 @@ def from_config(cfg, engine):
         observers.append(Clusters(float(cfg.observe.clusters.gap), engine))
     if cfg.observe.local_fields.cells is not None:
         observers.append(LocalFields(int(cfg.observe.local_fields.cells), engine))
+    if cfg.observe.mean_squared_displacement:
+        observers.append(MeanSquaredDisplacement(engine))
+    if cfg.observe.velocity_autocorrelation:
+        observers.append(VelocityAutocorrelation(engine))
+    if cfg.observe.pressure_tensor:
+        observers += [KineticTensor(engine), VirialTensor(engine)]
     return observers

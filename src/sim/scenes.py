@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.config import ConfigError
-from sim.engine import Boundary
+from sim.engine import Boundary, Engine
 from sim.initial import (
     RSA_JAMMING,
     PlacementError,
@@ -109,6 +109,7 @@ def gas(cfg):
 
 
 scene("cooling")(gas)
+scene("driven")(gas)
 
 
 @scene("mixture")
@@ -157,16 +158,49 @@ def scattering(cfg):
                  np.array([0, 1], np.int32), _boundary(cfg))
 
 
+def _bed(cfg):
+    """Positions float64[n, 2] of the bed disks, at rest in 0 ≤ y ≤ bed.height."""
+    b = cfg.bed
+    lx = float(cfg.box.size[0])
+    return _place(cfg, float(b.radius), int(b.n), region=((0.0, lx), (0.0, float(b.height))),
+                  key="bed.n")
+
+
+@scene("vibrated_bed")
+def vibrated_bed(cfg):
+    b = cfg.bed
+    n = int(b.n)
+    return Scene(_bed(cfg), np.zeros((n, 2)), np.full(n, float(b.radius)),
+                 np.full(n, float(b.mass)), np.zeros(n, np.int32), _boundary(cfg))
+
+
+def _settled(cfg, position):
+    """The bed after ``bed.settle_time`` alone under the scene's gravity, restitution and TC
+    model: (positions, velocities) float64[n, 2]."""
+    b = cfg.bed
+    engine = Engine(position, np.zeros_like(position), float(b.radius), float(b.mass),
+                    boundary=_boundary(cfg), restitution=float(cfg.restitution.disk),
+                    wall_restitution=float(cfg.restitution.wall), tc=cfg.tc.time,
+                    gravity=list(cfg.gravity), seed=cfg.seed)
+    engine.run(time=float(b.settle_time))
+    return engine.positions(b.settle_time), engine.velocities(b.settle_time)
+
+
 @scene("crater")
 def crater(cfg):
     p, b = cfg.projectile, cfg.bed
-    lx = float(cfg.box.size[0])
-    bed = _place(cfg, float(b.radius), int(b.n), region=((0.0, lx), (0.0, float(b.height))),
-                 key="bed.n")
+    bed = _bed(cfg)
+    bed_velocity = np.zeros_like(bed)
+    if b.settle_time is not None:
+        bed, bed_velocity = _settled(cfg, bed)
+        gap = np.hypot(*(bed - np.asarray(p.position)).T) - float(b.radius) - float(p.radius)
+        if gap.min() <= 0.0:
+            raise ConfigError("projectile.position", list(p.position),
+                              f"above the settled bed, whose top is at y = "
+                              f"{(bed[:, 1] + float(b.radius)).max():.4g}")
     n = int(b.n) + 1
     position = np.vstack([bed, [list(p.position)]])
-    velocity = np.zeros((n, 2))
-    velocity[-1] = [0.0, -float(p.speed)]
+    velocity = np.vstack([bed_velocity, [[0.0, -float(p.speed)]]])
     radius = np.append(np.full(n - 1, float(b.radius)), float(p.radius))
     projectile_mass = (float(p.mass) if p.mass is not None
                        else float(b.mass) * (float(p.radius) / float(b.radius)) ** 2)

@@ -15,12 +15,14 @@ Per-disk arrays (n disks, engine order):
   event_time float64[n], event_partner int32[n], event_count int32[n] — scheduled event;
   links int32[n, 3] — place in the event queue (:mod:`sim.event_queue`);
   nb_start int32[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
-  cell_next, cell_prev, cell_of int32[n] — cell lists; order int32[n] — original index.
+  cell_next, cell_prev, cell_of int32[n] — cell lists; order int32[n] — original index;
+  images int32[n, 2] — periodic windings (:mod:`sim.flight`), or None when not counted.
 Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
 calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells].
 """
 
 from dataclasses import dataclass, fields
+from typing import Optional
 
 import numpy as np
 
@@ -71,10 +73,12 @@ class DiskArrays:
     block_rate: np.ndarray
     big: np.ndarray
     cell_head: np.ndarray
+    images: Optional[np.ndarray] = None
 
     @property
     def nbytes(self):
-        return sum(getattr(self, f.name).nbytes for f in fields(self))
+        return sum(getattr(self, f.name).nbytes for f in fields(self)
+                   if getattr(self, f.name) is not None)
 
     @property
     def queue(self):
@@ -98,6 +102,8 @@ class DiskArrays:
                 self.table = table
             else:
                 setattr(self, name, np.ascontiguousarray(getattr(self, name)[perm]))
+        if self.images is not None:
+            self.images = np.ascontiguousarray(self.images[perm])
         for ids in (self.event_partner, self.cell_next, self.cell_prev, self.cell_head,
                     self.list_head, self.links[:, NEXT], self.links[:, PREV]):
             remap(ids)
