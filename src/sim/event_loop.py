@@ -110,7 +110,7 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
         if grid[2 + axis] == 0:
             tau_w, side = predict_wall_contact(axis, t_origin + t, disks[i, X + axis],
                                                disks[i, VX + axis], r_i, geometry, gravity,
-                                               motion)
+                                               motion, tau)
             if tau_w < tau:
                 tau = tau_w
                 # a search near a vibrating wall that stopped short: predict again from there

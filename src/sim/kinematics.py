@@ -187,7 +187,7 @@ OSCILLATING_STEPS = 64
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def first_contact_oscillating(h, v, a, amplitude, omega, phase, tolerance):
+def first_contact_oscillating(h, v, a, amplitude, omega, phase, tolerance, horizon):
     """First time τ ≥ 0 at which the gap f(τ) = h + v τ + a τ²/2 − A sin(ω τ + φ) closes:
     a disk on a parabola meeting a wall that oscillates as A sin(ω t) (a vibrated floor).
 
@@ -201,11 +201,14 @@ def first_contact_oscillating(h, v, a, amplitude, omega, phase, tolerance):
     round-off) and closing (f' < 0); a gap that small but opening is stepped over as if it
     were ``tolerance``. Otherwise τ is a point short of contact, reached after
     ``OSCILLATING_STEPS`` steps (e.g. a grazing approach), from which the caller predicts
-    again. τ = inf when the disk never reaches the band.
+    again. τ = inf when the disk never reaches the band, or not before ``horizon`` (the time
+    of an event already known to come first, which ends the search early).
     """
     curvature = abs(a) + amplitude * omega * omega
     tau = 0.0
     for _ in range(OSCILLATING_STEPS):
+        if tau > horizon:
+            return INF, False
         q = h + (v + 0.5 * a * tau) * tau
         q_rate = v + a * tau
         if q - amplitude > 0.0:

@@ -86,11 +86,12 @@ def wall_state(wall, t_abs, geometry, motion):
 
 
 @njit(cache=True, inline="always")
-def predict_wall_contact(axis, t_abs, x, v, radius, geometry, gravity, motion):
+def predict_wall_contact(axis, t_abs, x, v, radius, geometry, gravity, motion, horizon):
     """Time until the disk at coordinate ``x`` with velocity ``v`` along ``axis`` (at absolute
     time ``t_abs``) touches a wall of that axis. Returns (τ, side): side 0 or 1 for a contact,
     -1 for a time short of contact at which the disk must be predicted again (a search near a
-    vibrating wall that has not converged yet), τ = inf when no wall is reached."""
+    vibrating wall that has not converged yet), τ = inf when no wall is reached. A vibrating
+    wall is not searched beyond ``horizon``, the time of an event known to come first."""
     if gravity is None and motion is None:
         return wall_contact_time(x, v, radius, geometry[axis])
     a = 0.0 if gravity is None else gravity[axis]
@@ -115,7 +116,7 @@ def predict_wall_contact(axis, t_abs, x, v, radius, geometry, gravity, motion):
             tau, touching = first_contact_oscillating(
                 h, sign * (v - speed), sign * a, amplitude, omega,
                 omega * t_abs + (0.0 if side == 0 else math.pi),
-                CONTACT_TOLERANCE * geometry[axis])
+                CONTACT_TOLERANCE * geometry[axis], min(horizon, best))
         if tau < best:
             best = tau
             best_side = side if touching else -1
