@@ -12,7 +12,8 @@ def test_quick_figures(tmp_path):
     out = tmp_path / "quick"
     for name in ("fig01_single_disk", "fig02_two_disks", "fig03_scattering", "fig04_gas_snapshot",
                  "fig05_maxwell_boltzmann", "fig06_mixture", "fig07_mixture_cooling",
-                 "fig08_crater_grid", "fig09_crater_radius", "fig10_crater_speed"):
+                 "fig08_crater_grid", "fig09_crater_radius", "fig10_crater_speed",
+                 "fig11_crater_gravity"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
     x, y, energy = path[:, 2], path[:, 3], path[:, 4]
@@ -45,6 +46,9 @@ def test_quick_figures(tmp_path):
     # no energy scale: the same area at every speed, but for the TC model's fixed t_c
     for column in (2, 5):
         assert np.ptp(speed[:, column]) < 0.05 * speed[:, column].mean()
+    gravity = np.loadtxt(out / "fig11_crater_gravity.csv", delimiter=",", skiprows=1)
+    assert np.all(np.diff(gravity[:, 2]) > 0)  # more energy opens a larger cavity
+    assert np.all(gravity[:, 3] < 0.5 * gravity[:, 2])  # which mostly closes again
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
     main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from conftest import assert_no_overlap
-from sim.engine import Boundary, Engine, InelasticCollapseError
-from sim.initial import radius_for_packing, random_sequential
+from sim.engine import Boundary, Engine, InelasticCollapseError, StalledError
+from sim.initial import hexagonal_lattice, radius_for_packing, random_sequential
 
 G = 9.81
 
@@ -103,3 +103,24 @@ def test_gravity_along_a_periodic_axis_is_refused():
     with pytest.raises(ValueError, match="periodic axis"):
         Engine([[0.5, 0.5]], [[0.0, 0.0]], 0.01, gravity=[0.0, -1.0],
                boundary=Boundary(periodic=(True, True)))
+
+
+def test_disks_placed_at_rest_on_the_floor():
+    """A lattice whose bottom row touches the floor at rest: under the TC model those disks
+    leave with the bounce that lasts t_c and the bed runs, energy booked as the floor's work;
+    without it the floor would hold them through infinitely many contacts at one instant,
+    and the run stops with a clear error."""
+    n, radius = 200, 0.01
+    position = hexagonal_lattice(n, radius, region=((0.0, 1.0), (0.0, 0.2)), seed=1)
+    assert np.isclose(position[:, 1].min(), radius, rtol=0, atol=1e-15)
+    engine = Engine(position, np.zeros((n, 2)), radius, gravity=[0.0, -1.0], restitution=0.8,
+                    wall_restitution=0.8, tc=1e-3)
+    energy = engine.potential_energy()
+    engine.run(time=1.0)
+    assert_no_overlap(engine)
+    balance = (engine.kinetic_energy() + engine.potential_energy() + engine.dissipated_energy
+               - engine.wall_work - energy)
+    assert abs(balance) <= 1e-12 * engine.dissipated_energy
+    elastic = Engine(position, np.zeros((n, 2)), radius, gravity=[0.0, -1.0])
+    with pytest.raises(StalledError, match="resting on a wall under gravity"):
+        elastic.run(time=1.0)

@@ -400,7 +400,8 @@ class Engine:
                     f"in a row at one instant, last for disk {d.order[disk]} at position "
                     f"{d.table[disk, X:Y + 1].tolist()} with velocity "
                     f"{d.table[disk, VX:VY + 1].tolist()}; the state is beyond float64 resolution "
-                    f"(for inelastic disks, switch on the TC model)")
+                    f"(for inelastic disks, and for disks resting on a wall under gravity, "
+                    f"switch on the TC model)")
             if status == loop.STATUS_COLLAPSE:
                 cluster = set(np.flatnonzero(d.streak >= 2).tolist()) | {int(disk)}
                 raise InelasticCollapseError(sorted(int(d.order[k]) for k in cluster),

@@ -310,7 +310,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
             if temperature is not None:
                 key = contact_key(seed, wall_collisions)
             lost, impulse, work = hit_wall(i, wall, accumulators[T_ORIGIN] + t, xi_w, disks,
-                                           per_disk(mass, i), geometry, motion, temperature, key)
+                                           per_disk(mass, i), geometry, motion, temperature, key,
+                                           gravity, tc)
             dissipated_walls += lost
             wall_work += work
             wall_impulse[wall] += impulse

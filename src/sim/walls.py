@@ -145,13 +145,18 @@ def contact_key(seed, contact):
 
 
 @njit(cache=True, inline="always")
-def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, motion, temperature, key):
+def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, motion, temperature, key, gravity,
+             tc):
     """Disk i (mass m, at the time of contact) touches ``wall``: clamp it inside the wall
     against round-off, then reflect it (hard wall) or redraw its velocity (thermal wall).
 
     Returns (energy dissipated, momentum given to the wall along its axis, work done by the
     wall on the disk), so that E_kin changes by work − dissipated. A disk found receding
-    from the wall (round-off) keeps its velocity.
+    from the wall (round-off) keeps its velocity. A disk resting on a still wall that gravity
+    presses it against (placed there at rest) would touch it again at once, for ever; under
+    the TC model it leaves with the speed g t_c/2 of a bounce lasting t_c (the bounces the
+    model settles resting disks into), the wall doing that work, and without it the clock
+    stalls (:class:`sim.engine.StalledError`).
     """
     axis = wall >> 1
     other = 1 - axis
@@ -175,6 +180,11 @@ def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, motion, temperature, k
             return 0.0, m * (v_n - disks[i, VX + axis]), work
     w_n = v_n - u
     if sign * w_n >= 0.0:
+        if gravity is not None and tc is not None and motion is None:
+            if w_n == 0.0 and sign * gravity[axis] < 0.0:
+                disks[i, VX + axis] = sign * 0.5 * abs(gravity[axis]) * tc
+                lift = disks[i, VX + axis]
+                return 0.0, -m * lift, 0.5 * m * lift * lift
         return 0.0, 0.0, 0.0
     disks[i, VX + axis] = u - xi_wall * w_n
     lost = 0.5 * (1.0 - xi_wall * xi_wall) * m * w_n * w_n
