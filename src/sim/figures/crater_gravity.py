@@ -14,7 +14,9 @@ the cavity is the area under the surface that no disk (projectile included) over
 that area before impact, and its largest value over the snapshots is the crater. The impact
 energy is the projectile's kinetic energy when it reaches the surface,
 E = m v₀²/2 + m g (y₀ − R − surface). A power law A ∝ E^β is fitted in log–log over the
-runs whose cavity covers at least one grid cell. In 2D the gravity regime with energy scaling
+runs whose cavity covers at least one grid cell, and again over those whose cavity is larger
+than the projectile's own area πR² (smaller ones are shaped by the projectile's size and the
+grid more than by the energy). In 2D the gravity regime with energy scaling
 (the cavity's mass lifted by its own depth, E ~ ρ g R³) gives β = 2/3 (physics.md,
 "Cratering"); momentum scaling gives smaller exponents.
 """
@@ -75,11 +77,17 @@ def draw(runs, sweeps, out_dir):
     final = np.array([c[1][-1] for c in cavities])
     opened = area > 0.0  # a cavity below one grid cell is not resolved
     fit = stats.linregress(np.log(energy[opened]), np.log(area[opened]))
+    projectile_area = np.pi * float(ds["radius"].values[-1]) ** 2
+    large = area > projectile_area
+    large_fit = stats.linregress(np.log(energy[large]), np.log(area[large]))
     fig, (left, right) = figure(width=10)
     curve = np.geomspace(energy.min(), energy.max(), 100)
     left.loglog(energy[opened], area[opened], "o", color="C0", label="largest cavity")
     left.loglog(curve, np.exp(fit.intercept) * curve**fit.slope, "-", color="C0", lw=1,
                 label=f"fit A ∝ E^{fit.slope:.2f} (β = {fit.slope:.2f} ± {fit.stderr:.2f})")
+    left.loglog(energy[large], np.exp(large_fit.intercept) * energy[large] ** large_fit.slope,
+                "--", color="C3", lw=1, label=f"fit over A > πR²: β = {large_fit.slope:.2f} ± "
+                                             f"{large_fit.stderr:.2f}")
     middle = (np.exp(np.mean(np.log(area[opened])))
               * (curve / np.exp(np.mean(np.log(energy[opened])))) ** (2 / 3))
     left.loglog(curve, middle, "k:", lw=1, label="β = 2/3 (2D gravity, energy scaling)")
@@ -95,5 +103,7 @@ def draw(runs, sweeps, out_dir):
     np.savetxt(out_dir / f"{NAME}.csv", np.column_stack([speed, energy, area, final]),
                delimiter=",", fmt="%.6g",
                header=f"projectile_speed,impact_energy,largest_cavity_area,final_cavity_area  "
-                      f"(fit: exponent {fit.slope:.4f} +- {fit.stderr:.4f})", comments="")
+                      f"(fit: exponent {fit.slope:.4f} +- {fit.stderr:.4f}; over cavities "
+                      f"larger than the projectile: {large_fit.slope:.4f} +- "
+                      f"{large_fit.stderr:.4f})", comments="")
     return save(fig, out_dir, NAME)

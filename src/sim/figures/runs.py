@@ -49,10 +49,22 @@ def ensure_run(label, overrides, root):
     return path
 
 
+def _first_value(override):
+    """``key=a,b,c`` → ``key=a``; lists (``key=[a,b]``) and plain overrides stay whole."""
+    key, _, value = override.partition("=")
+    if not value or value.startswith("["):
+        return override
+    return f"{key}={value.split(',')[0]}"
+
+
 def ensure_sweep(label, overrides, root):
-    """The directory of a Hydra multirun over ``overrides`` (with comma lists or range()),
-    run only if it has not completed before."""
-    key = " ".join(sorted(overrides))
+    """The directory of a Hydra multirun over ``overrides`` (with comma lists), run only if
+    it has not completed before: keyed by the overrides and the resolved config of its first
+    job, so that a changed scene file makes the sweep again."""
+    first_job = [_first_value(o) for o in overrides]
+    resolved = OmegaConf.to_yaml(compose_config([*first_job, "output.progress=false"]),
+                                 resolve=True)
+    key = " ".join(sorted(overrides)) + resolved
     folder = Path(root) / f"{label}-{_digest(key)}"
     if not (folder / "sweep_summary.yaml").exists():
         command = [sys.executable, "-m", "sim", *overrides, "output.progress=false",
