@@ -170,3 +170,26 @@ def test_event_log_holds_every_contact(tmp_path):
         virial, rel=1e-9)
     assert set(np.unique(log["partner"].where(~disk_contacts, drop=True))) <= {-1, -2, -3, -4}
     assert int(log["disk"].max()) < 500
+
+
+def test_event_log_streams_to_the_file_between_snapshots(tmp_path):
+    """A run that logs much between snapshots does not hold the log in memory: each full
+    buffer of the loop goes to the writer, which writes it once it holds buffer_bytes."""
+    from sim.engine import Engine
+    from sim.h5md import RunWriter
+    from sim.initial import fixed_speed, radius_for_packing, random_sequential
+
+    n = 300
+    radius = radius_for_packing(n, 0.2)
+    engine = Engine(random_sequential(np.full(n, radius), seed=1), fixed_speed(n, 1.0, seed=2),
+                    radius, event_log=1000)
+    writer = RunWriter(tmp_path / "run.h5", engine, {"config": "scene: gas\n", "seed": 0},
+                       buffer_bytes=48 * 2000)
+    writer.snapshot(engine, 0.0)
+    engine.run(collisions=10_000)
+    written = writer.file["events/contacts"].shape[0]
+    assert 8_000 <= written <= engine.events
+    writer.snapshot(engine)
+    writer.flush()
+    assert writer.file["events/contacts"].shape[0] == engine.events
+    writer.close()

@@ -151,8 +151,9 @@ class Engine:
         displacements)
     pressure_tensor : accumulate the collision virial tensor Σ r_a Δp_b
         (:attr:`virial_tensor`)
-    event_log : rows buffered for the log of every contact (:meth:`take_event_log`); None =
-        no log
+    event_log : rows buffered in the loop for the log of every contact; None = no log. Full
+        buffers go to :attr:`event_sink` (a callable taking float64[k, 6], e.g. the run
+        file's writer) or else are kept for :meth:`take_event_log`
     collapse_interval, collapse_streak : inelastic-collapse detector: more than
         ``collapse_streak`` consecutive dissipative contacts of one disk, each within
         ``collapse_interval`` of the previous one. The default interval is 1e-6 of the time
@@ -239,6 +240,7 @@ class Engine:
                           else np.zeros((max(int(event_log), 1), LOG_COLUMNS)))
         self.log_fill = np.zeros(1, dtype=np.int64)
         self._logged = []
+        self.event_sink = None
         self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
         self.rebase_every = 16 * n + 1024
         self.reorder_every = (REORDER_EVENTS_PER_DISK * n if n >= REORDER_MIN_DISKS
@@ -384,7 +386,7 @@ class Engine:
                 min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
                 dissipation_limit,
                 self.collapse_interval, self.collapse_streak, self.rebase_every)
-            self._drain_event_log()
+            self.drain_event_log()
             if status == loop.STATUS_LOG_FULL:
                 continue
             if status == loop.STATUS_EVENT_LIMIT and self.counters[loop.EVENTS] == reorder_at:
@@ -507,7 +509,7 @@ class Engine:
         """Every array that evolves, by name: restoring it into an engine built from the same
         inputs continues the run to the same bits."""
         loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
-        self._drain_event_log()
+        self.drain_event_log()
         state = {f"disks/{name}": value for name, value in vars(self.disks).items()
                  if value is not None}
         state.update(counters=self.counters, accumulators=self.accumulators,
@@ -604,9 +606,10 @@ class Engine:
         return (d.mass[:, None] * self._state(t)[1]).sum(axis=0)
 
     # -- event log ------------------------------------------------------------------------
-    def _drain_event_log(self):
-        """Move the rows of the compiled log to :attr:`_logged`, disks renamed to the user's
-        numbering (the engine's own numbering changes when it reorders)."""
+    def drain_event_log(self):
+        """Hand the rows of the compiled log to :attr:`event_sink` (else keep them for
+        :meth:`take_event_log`), disks renamed to the user's numbering (the engine's own
+        numbering changes when it reorders)."""
         if self.event_log is None or self.log_fill[0] == 0:
             return
         rows = self.event_log[:self.log_fill[0]].copy()
@@ -615,13 +618,16 @@ class Engine:
         partner = rows[:, LOG_PARTNER].astype(np.int64)
         disk = partner >= 0
         rows[disk, LOG_PARTNER] = order[partner[disk]]
-        self._logged.append(rows)
         self.log_fill[0] = 0
+        if self.event_sink is None:
+            self._logged.append(rows)
+        else:
+            self.event_sink(rows)
 
     def take_event_log(self):
         """The contacts logged since the last call: float64[k, 6], columns as in
         :mod:`sim.recorders` (disks in the user's numbering)."""
-        self._drain_event_log()
+        self.drain_event_log()
         rows = (np.concatenate(self._logged) if self._logged
                 else np.zeros((0, LOG_COLUMNS)))
         self._logged = []

@@ -84,10 +84,13 @@ class RunWriter:
         self._last_flush = -math.inf
         self._frames = []  # buffered (step, time, position, velocity, observables)
         self._contacts = []  # buffered rows of the event log
+        self._contact_bytes = 0
         self.file = h5py.File(path, mode)
         if mode == "w":
             self._create(engine, parameters)
         self._flushed_frames = self.file["particles/disks/position/step"].shape[0]
+        if engine.event_log is not None:
+            engine.event_sink = self._log_contacts
 
     def _create(self, engine, parameters):
         f = self.file
@@ -159,7 +162,7 @@ class RunWriter:
             observables[observer.name] = observer(engine, t, position, velocity)
         self._frames.append((engine.events, t, position, velocity, observables))
         if engine.event_log is not None:
-            self._contacts.append(engine.take_event_log())
+            engine.drain_event_log()  # into _log_contacts
         now = wallclock.monotonic()
         if checkpoint or now - self._last_checkpoint >= self.checkpoint_seconds:
             self.flush()
@@ -168,6 +171,24 @@ class RunWriter:
         elif (now - self._last_flush >= self.flush_seconds
               or len(self._frames) * 2 * engine.n * 16 >= self.buffer_bytes):
             self.flush()
+
+    def _log_contacts(self, rows):
+        """Buffer rows of the event log; written with the frames, or as soon as they fill
+        ``buffer_bytes`` (a run that logs much between snapshots streams them)."""
+        self._contacts.append(rows)
+        self._contact_bytes += rows.nbytes
+        if self._contact_bytes >= self.buffer_bytes:
+            self._write_contacts()
+
+    def _write_contacts(self):
+        if self._contacts:
+            rows = np.concatenate(self._contacts)
+            contacts = self.file["events/contacts"]
+            first = contacts.shape[0]
+            contacts.resize(first + rows.shape[0], axis=0)
+            contacts[first:] = rows
+            self._contacts.clear()
+            self._contact_bytes = 0
 
     def flush(self):
         """Write the buffered frames and flush the file."""
@@ -182,13 +203,7 @@ class RunWriter:
                               [o[name] for o in observables])
             self._flushed_frames += len(self._frames)
             self._frames.clear()
-        if self._contacts:
-            rows = np.concatenate(self._contacts)
-            contacts = self.file["events/contacts"]
-            first = contacts.shape[0]
-            contacts.resize(first + rows.shape[0], axis=0)
-            contacts[first:] = rows
-            self._contacts.clear()
+        self._write_contacts()
         self.file.flush()
         self._last_flush = wallclock.monotonic()
 
