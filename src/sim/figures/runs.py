@@ -12,6 +12,7 @@ from pathlib import Path
 
 import h5py
 from hydra import compose, initialize_config_dir
+from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import OmegaConf
 
 from sim.__main__ import CONF_DIR
@@ -50,11 +51,12 @@ def ensure_run(label, overrides, root):
 
 
 def _first_value(override):
-    """``key=a,b,c`` → ``key=a``; lists (``key=[a,b]``) and plain overrides stay whole."""
-    key, _, value = override.partition("=")
-    if not value or value.startswith("["):
+    """The first job's value of a sweep override (``key=a,b,c`` → ``key=a``, ``range(0,4)`` →
+    0), parsed by Hydra's own override grammar; other overrides stay whole."""
+    parsed = OverridesParser.create().parse_override(override)
+    if not parsed.is_sweep_override():
         return override
-    return f"{key}={value.split(',')[0]}"
+    return f"{parsed.get_key_element()}={next(iter(parsed.sweep_string_iterator()))}"
 
 
 def ensure_sweep(label, overrides, root):
