@@ -223,7 +223,7 @@ class Engine:
         if any(periodic[WALLS[name] >> 1] for name, spec in walls.items() if spec):
             raise ValueError(f"walls {walls} are given on a periodic axis, which has none")
         by_number = {WALLS[name]: dict(spec) for name, spec in walls.items() if spec}
-        self.wall_motion = wall_motion(by_number, box)
+        self.wall_motion = wall_motion(by_number)
         self.wall_temperature = wall_temperature(by_number)
         self.seed = int(seed)
         self.closing_time = _closing_time(self.wall_motion, box, periodic, float(radius.max()))

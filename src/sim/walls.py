@@ -44,7 +44,7 @@ _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX_2 = np.uint64(0x94D049BB133111EB)
 
 
-def wall_motion(walls, box):
+def wall_motion(walls):
     """float64[4, 3] of (U, A, ω) per wall for the compiled loop, or None when no wall moves.
 
     ``walls`` maps wall numbers to dicts with the keys speed, amplitude, frequency (angular).
