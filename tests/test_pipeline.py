@@ -159,6 +159,11 @@ def run_cli(*args, cwd):
     "walls.top.speed=-0.1 box.boundary=periodic",
     "walls.middle.speed=1",
     "scenario=crater bed.settle_time=1",
+    "scenario=crater projectile.position=[2,0.9]",
+    "scenario=two_disks two_disks.positions=[[0.5,0.5],[0.51,0.5]]",
+    "scenario=mixture mixture.fractions=[0.7,0.7]",
+    "stop.collisions=null stop.time=null stop.energy_fraction=null",
+    "output.every_collisions=100 output.every_time=0.1",
 ])
 def test_bad_values_exit_2_with_one_line_and_no_file(override, tmp_path):
     result = run_cli(*override.split(), f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)

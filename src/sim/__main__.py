@@ -6,6 +6,7 @@ before any work starts: a bad key, type or value prints one line and exits with 
 
 import itertools
 import logging
+import os
 import sys
 from pathlib import Path
 
@@ -22,6 +23,9 @@ from sim.config import ConfigError, register, validate
 
 CONF_DIR = str((Path(__file__).resolve().parents[2] / "conf"))
 EXIT_BAD_CONFIG = 2
+EXIT_RUN_FILE = 1  # the run file could not be written
+EXIT_INTERRUPTED = 130  # stopped by SIGINT, as shells report it
+INTERRUPTED = []  # single runs that SIGINT stopped
 
 register()
 
@@ -99,21 +103,47 @@ def check_command_line(args):
                   f"{' '.join(combination) or 'default config'}: {_first_line(error)}")
 
 
+def _existing_run(output_dir, cfg):
+    """The run file a job has already made in ``output_dir`` (a sweep run again into its own
+    folder): (path, stop reason, whether it has a checkpoint), or (None, None, False)."""
+    import h5py
+
+    path = Path(output_dir) / cfg.output.file
+    try:
+        with h5py.File(path, "r") as f:
+            return path, str(f["parameters"].attrs["stop_reason"]), "checkpoint" in f
+    except (OSError, KeyError):
+        return None, None, False
+
+
 @hydra.main(config_path=CONF_DIR, config_name="config", version_base="1.3")
 def hydra_main(cfg):
     from sim.inspect import summary
-    from sim.runner import resume, run
+    from sim.runner import FINISHED, RunFileError, resume, run
 
     sweeping = HydraConfig.get().mode == RunMode.MULTIRUN
+    output_dir = HydraConfig.get().runtime.output_dir
     try:
+        existing, reason, resumable = _existing_run(output_dir, cfg)
         if cfg.resume is not None:
             path = resume(cfg.resume)
+        elif existing is not None and reason in FINISHED:
+            path = existing  # a sweep run again: this job is complete
+            print(f"sim: {path} is complete (stopped by {reason}); not run again")
+        elif existing is not None and resumable:
+            path = resume(existing)  # a sweep run again: continue the job where it stopped
         else:
-            path = run(cfg, HydraConfig.get().runtime.output_dir)
+            path = run(cfg, output_dir)
     except ConfigError as error:
         if not sweeping:
             _fail(str(error))
         return {"failed": f"ConfigError: {error}"}
+    except RunFileError as error:
+        if not sweeping:
+            print(f"sim: {error}", file=sys.stderr, flush=True)
+            # a file whose write failed can crash HDF5 when Python tears down: leave now
+            os._exit(EXIT_RUN_FILE)
+        return {"failed": f"RunFileError: {error}"}
     except Exception as error:
         if not sweeping:
             raise
@@ -125,6 +155,8 @@ def hydra_main(cfg):
           f"{info['final_energy']:.6g} (dissipated {info['dissipated_energy']:.3g}, balance "
           f"error {info['energy_drift']:.1e}), stopped by {info['stop_reason']}\n"
           f"run file: {path}")
+    if info["stop_reason"] == "interrupted" and not sweeping:
+        INTERRUPTED.append(path)
     return str(path)
 
 
@@ -133,6 +165,10 @@ def main():
     hydra_main()
     if callbacks.FAILED_JOBS:
         sys.exit(1)
+    if INTERRUPTED:
+        print(f"sim: interrupted; continue with: python -m sim resume={INTERRUPTED[0]}",
+              file=sys.stderr)
+        sys.exit(EXIT_INTERRUPTED)
 
 
 if __name__ == "__main__":

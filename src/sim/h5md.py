@@ -24,7 +24,9 @@ leaves a file readable up to its last flush, and a run with frequent small snaps
 spend its time in HDF5 calls. ``step`` counts contacts (disk–disk and disk–wall).
 """
 
+import errno
 import math
+import shutil
 import time as wallclock
 
 import h5py
@@ -68,6 +70,20 @@ def _write_frames(group, first, steps, times, values):
         dataset = group[name]
         dataset.resize(first + len(items), axis=0)
         dataset[first:] = np.asarray(items)
+
+
+#: Room kept free on the run file's disk beyond what a write needs: HDF5 adds metadata, and a
+#: write that fails half-way leaves a file HDF5 cannot open again.
+DISK_MARGIN_BYTES = 64 << 20
+
+
+class DiskFullError(OSError):
+    """Too little room on the disk for the next write; nothing of it was written."""
+
+
+def free_bytes(folder):
+    """Free bytes on the disk holding ``folder``."""
+    return shutil.disk_usage(folder).free
 
 
 class RunWriter:
@@ -190,8 +206,19 @@ class RunWriter:
             self._contacts.clear()
             self._contact_bytes = 0
 
+    def _make_room(self, nbytes):
+        """Raise :class:`DiskFullError` before a write of ``nbytes`` that the disk could not
+        take whole (with :data:`DISK_MARGIN_BYTES` to spare): the file then stays as its last
+        flush left it, readable."""
+        free = free_bytes(self.path.parent)
+        if free < nbytes + DISK_MARGIN_BYTES:
+            raise DiskFullError(errno.ENOSPC, f"{free} bytes free on the disk of {self.path}, "
+                                f"the next write needs {nbytes} and {DISK_MARGIN_BYTES} to spare")
+
     def flush(self):
         """Write the buffered frames and flush the file."""
+        self._make_room(sum(p.nbytes + v.nbytes for _, _, p, v, _ in self._frames)
+                        + self._contact_bytes)
         if self._frames:
             steps, times, positions, velocities, observables = zip(*self._frames, strict=True)
             disks = self.file["particles/disks"]
@@ -210,10 +237,12 @@ class RunWriter:
     def _checkpoint(self, engine, t):
         """Store the engine state in the older of two slots, then point ``latest`` at it:
         a run killed while writing keeps the previous, complete checkpoint."""
+        state = engine.state_dict()
+        self._make_room(sum(np.asarray(value).nbytes for value in state.values()))
         root = self.file.require_group("checkpoint")
         slot = "b" if root.attrs.get("latest", "b") == "a" else "a"
         group = root.require_group(slot)
-        for key, value in engine.state_dict().items():
+        for key, value in state.items():
             value = np.asarray(value)
             if key in group and group[key].shape[1:] == value.shape[1:] and value.ndim:
                 dataset = group[key]
@@ -250,6 +279,26 @@ class RunWriter:
     def close(self):
         if self.file.id.valid:
             self.file.close()
+
+    def give_up(self, reason):
+        """Record ``reason`` as the stop reason without writing the buffered frames (the disk
+        has no room for them): the file stays as its last flush left it."""
+        self._frames.clear()
+        self._contacts.clear()
+        self._contact_bytes = 0
+        try:
+            self.file["parameters"].attrs["stop_reason"] = reason
+            self.file.flush()
+        except (OSError, RuntimeError):
+            pass
+
+    def abandon(self):
+        """Close after a failed write, without writing more: HDF5 may refuse to close a file
+        whose last write failed, and the error that caused it is the one to report."""
+        try:
+            self.close()
+        except (OSError, RuntimeError):
+            pass
 
 
 def read_checkpoint(file):

@@ -7,8 +7,10 @@ from its last checkpoint to the same bits as a run never interrupted.
 """
 
 import math
+import signal
 import subprocess
 import sys
+import threading
 import time as wallclock
 from pathlib import Path
 
@@ -20,12 +22,41 @@ from tqdm import tqdm
 import sim
 from sim.config import ConfigError, SimConfig, validate
 from sim.engine import Engine
-from sim.h5md import RunWriter, read_checkpoint
+from sim.h5md import DiskFullError, RunWriter, read_checkpoint
 from sim.observers import from_config as observers_from_config
 from sim.scenes import build_scene
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
 FINISHED = ("collisions", "events", "time", "energy_fraction", "at_rest", "no_events")
+
+
+class RunFileError(OSError):
+    """The run file cannot be created or written (read-only folder, full disk)."""
+
+
+class Interruption:
+    """SIGINT (Ctrl-C) asks the run to stop: the engine finishes its compiled chunk, the
+    runner writes a final snapshot and checkpoint, and the run ends with stop reason
+    ``interrupted`` (``resume`` continues it). A second SIGINT interrupts at once. Installed
+    only in the main thread, and only for the run."""
+
+    def __init__(self):
+        self.requested = False
+        self._previous = None
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._request)
+        return self
+
+    def _request(self, signum, frame):
+        self.requested = True
+        signal.signal(signal.SIGINT, self._previous)
+
+    def __exit__(self, *exc):
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+        return False
 
 
 def at_rest(fraction):
@@ -98,9 +129,18 @@ def _progress(cfg, engine):
 
 def advance(engine, cfg, writer, last_time):
     """Run from snapshot to snapshot (the last one at ``last_time``) until a stop condition
-    holds; returns its name."""
+    holds or SIGINT arrives (:class:`Interruption`); returns the stop reason."""
+    with Interruption() as interruption:
+        return _advance(engine, cfg, writer, last_time, interruption)
+
+
+def _advance(engine, cfg, writer, last_time, interruption):
     stop, out = cfg.stop, cfg.output
-    until = None if stop.at_rest is None else at_rest(stop.at_rest)
+    resting = None if stop.at_rest is None else at_rest(stop.at_rest)
+
+    def until(engine):
+        return interruption.requested or (resting is not None and resting(engine))
+
     started = wallclock.perf_counter()
     bar = _progress(cfg, engine)
     try:
@@ -120,7 +160,9 @@ def advance(engine, cfg, writer, last_time):
             snapshot_time = t_stop if reason == "time" else None
             if reason == "no_events" and t_stop < math.inf:
                 snapshot_time, reason = t_stop, "time"
-            if reason == "predicate" or (until is not None and until(engine)):
+            if interruption.requested:
+                reason = "interrupted"
+            elif reason == "predicate" or (resting is not None and resting(engine)):
                 reason = "at_rest"  # checked between chunks and at every snapshot
             last_time = engine.time if snapshot_time is None else snapshot_time
             last = {"collisions": stop.collisions is not None
@@ -136,16 +178,36 @@ def advance(engine, cfg, writer, last_time):
         bar.close()
 
 
+def _writer(path, engine, cfg, mode="w"):
+    """The run file's writer, or :class:`RunFileError` when the file cannot be made."""
+    try:
+        return RunWriter(path, engine, parameters(cfg), mode=mode,
+                         observers=observers_from_config(cfg, engine))
+    except OSError as error:
+        raise RunFileError(f"cannot write the run file {path}: "
+                           f"{error.strerror or error}") from error
+
+
 def _record(writer, work):
     """Run ``work()`` (which returns the stop reason) and record how the run ended — its
-    stop reason or its error — in the file, which is closed on every path."""
+    stop reason or its error — in the file, which is closed on every path. A failed write
+    (a full disk) becomes :class:`RunFileError`; the file keeps what its last flush wrote."""
     try:
         writer.finish(work())
+    except DiskFullError as error:
+        writer.give_up(f"error: disk full: {error.strerror}")
+        raise RunFileError(f"stopped before writing to {writer.path}: {error.strerror}. The "
+                           f"file holds every snapshot up to its last flush; free some room and "
+                           f"resume from its last checkpoint") from error
+    except OSError as error:
+        writer.abandon()
+        reason = " ".join(str(error).split())  # HDF5's messages span lines
+        raise RunFileError(f"writing the run file {writer.path} failed: {reason}") from error
     except BaseException as error:
         writer.finish(f"error: {type(error).__name__}: {error}")
         raise
     finally:
-        writer.close()
+        writer.abandon()
 
 
 def run(cfg, output_dir="."):
@@ -154,9 +216,8 @@ def run(cfg, output_dir="."):
         cfg = OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
     validate(cfg)
     engine = build_engine(cfg)
-    observers = observers_from_config(cfg, engine)
     path = Path(output_dir) / cfg.output.file
-    writer = RunWriter(path, engine, parameters(cfg), observers=observers)
+    writer = _writer(path, engine, cfg)
 
     def from_the_start():
         writer.snapshot(engine, 0.0)
@@ -172,13 +233,16 @@ def resume(path):
     with h5py.File(path, "r") as f:
         config_yaml = f["parameters"].attrs["config"]
         reason = str(f["parameters"].attrs["stop_reason"])
+        checkpointed = "checkpoint" in f and "latest" in f["checkpoint"].attrs
     if reason in FINISHED:
         return path  # nothing left to do: the run ended by one of its stop conditions
     cfg = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(config_yaml))
+    if not checkpointed:  # stopped before its first checkpoint was complete: start again
+        cfg.output.file = path.name
+        return run(cfg, path.parent)
     validate(cfg)
     engine = build_engine(cfg)
-    writer = RunWriter(path, engine, parameters(cfg), mode="r+",
-                       observers=observers_from_config(cfg, engine))
+    writer = _writer(path, engine, cfg, mode="r+")
 
     def from_the_checkpoint():
         state, last_time, snapshots = read_checkpoint(writer.file)

@@ -1,0 +1,149 @@
+"""Faults: runs killed at random moments, Ctrl-C, a full disk, a folder that cannot be
+written; each leaves a readable file (or none) and a clear message, and resume continues to
+the same bits."""
+
+import resource
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import sim.h5md
+from sim import runner
+from sim.figures.runs import compose_config
+from sim.inspect import summary
+
+#: a gas that runs for a few seconds, to be killed in the middle: 2000 disks, 300 snapshots;
+#: frames are flushed at least every second, and only the first snapshot is checkpointed
+#: before the end (checkpoints come every 30 s), so resume starts from it and makes every frame
+#: after it again
+LONG_RUN = ["disks.n=2000", "stop.collisions=6000000", "output.every_collisions=20000",
+            "output.progress=false"]
+
+
+def cli(*args, cwd, **options):
+    return subprocess.Popen([sys.executable, "-m", "sim", *args], cwd=cwd,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **options)
+
+
+def frames(path):
+    with h5py.File(path, "r") as f:
+        return (f["particles/disks/position/step"][()], f["particles/disks/position/value"][()],
+                str(f["parameters"].attrs["stop_reason"]))
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("whole")
+    return runner.run(compose_config(LONG_RUN), folder)
+
+
+def run_until_killed(folder, after_seconds, how):
+    process = cli(*LONG_RUN, f"hydra.run.dir={folder}", cwd=folder)
+    deadline = time.monotonic() + 120
+    while not (folder / "run.h5").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)  # compiling; the clock starts with the run file
+    time.sleep(after_seconds)
+    process.send_signal(how)
+    out, err = process.communicate(timeout=300)
+    return process.returncode, err
+
+
+@pytest.mark.parametrize("after_seconds", [0.3, 1.1, 2.6])
+def test_a_run_killed_at_any_moment_opens_and_resumes_to_the_same_bits(
+        after_seconds, uninterrupted, tmp_path):
+    code, _ = run_until_killed(tmp_path, after_seconds, signal.SIGKILL)
+    assert code == -signal.SIGKILL
+    path = tmp_path / "run.h5"
+    info = summary(path)  # opens, with every frame flushed before the kill
+    assert info["stop_reason"] == "running"
+    runner.resume(path)
+    steps, positions, reason = frames(path)
+    whole_steps, whole_positions, _ = frames(uninterrupted)
+    assert reason == "collisions"
+    np.testing.assert_array_equal(steps, whole_steps)
+    np.testing.assert_array_equal(positions, whole_positions)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("after_seconds", np.round(np.random.default_rng(9).uniform(0.0, 4.0, 20),
+                                                   2).tolist())
+def test_twenty_random_kills(after_seconds, uninterrupted, tmp_path):
+    test_a_run_killed_at_any_moment_opens_and_resumes_to_the_same_bits(
+        after_seconds, uninterrupted, tmp_path)
+
+
+def test_ctrl_c_stops_with_a_final_snapshot_and_resume_finishes_the_run(uninterrupted,
+                                                                         tmp_path):
+    """SIGINT: the chunk ends, a final snapshot and checkpoint are written, the run ends as
+    ``interrupted`` with exit status 130 and a hint; resume gives the uninterrupted frames,
+    and at most the interruption's own frame between them (none when it came at a snapshot,
+    as here: a snapshot interval is shorter than a compiled chunk)."""
+    code, err = run_until_killed(tmp_path, 1.0, signal.SIGINT)
+    assert code == 130
+    assert "resume=" in err.strip().splitlines()[-1]
+    path = tmp_path / "run.h5"
+    steps, _, reason = frames(path)
+    assert reason == "interrupted"
+    with h5py.File(path, "r") as f:  # the final frame is the checkpointed state
+        checkpoint = f["checkpoint"][f["checkpoint"].attrs["latest"]]
+        assert checkpoint.attrs["snapshots"] == steps.size
+    runner.resume(path)
+    steps, positions, reason = frames(path)
+    whole_steps, whole_positions, _ = frames(uninterrupted)
+    assert reason == "collisions"
+    common = np.isin(steps, whole_steps)
+    assert common.sum() == whole_steps.size and (~common).sum() <= 1
+    np.testing.assert_array_equal(positions[common], whole_positions)
+
+
+def test_a_disk_that_fills_up_stops_the_run_before_a_write_and_keeps_the_file(
+        tmp_path, monkeypatch):
+    calls = {"n": 0}
+
+    def filling_up(folder):
+        calls["n"] += 1
+        return 10**12 if calls["n"] <= 2 else sim.h5md.DISK_MARGIN_BYTES // 2
+
+    monkeypatch.setattr(sim.h5md, "free_bytes", filling_up)
+    cfg = compose_config(["disks.n=500", "stop.collisions=200000",
+                          "output.every_collisions=1000", "output.progress=false"])
+    with pytest.raises(runner.RunFileError, match="free some room and resume"):
+        runner.run(cfg, tmp_path)
+    monkeypatch.undo()
+    info = summary(tmp_path / "run.h5")
+    assert info["stop_reason"].startswith("error: disk full")
+    assert info["snapshots"] >= 1
+    runner.resume(tmp_path / "run.h5")
+    assert summary(tmp_path / "run.h5")["stop_reason"] == "collisions"
+
+
+def test_a_write_the_system_refuses_ends_with_one_line(tmp_path):
+    """A file-size limit makes the operating system refuse a write mid-run (as a full disk
+    does when the free-space check cannot see it coming): exit status 1, one line."""
+    def limited():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1 << 20, 1 << 20))
+
+    process = cli("disks.n=2000", "output.every_collisions=1000", f"hydra.run.dir={tmp_path}",
+                  cwd=tmp_path, preexec_fn=limited)
+    _, err = process.communicate(timeout=300)
+    assert process.returncode == 1
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("sim: writing the run file")
+
+
+def test_a_folder_that_cannot_be_written_is_a_clear_error(tmp_path):
+    cfg = compose_config(["disks.n=100", "output.file=/proc/run.h5", "output.progress=false"])
+    with pytest.raises(runner.RunFileError, match="cannot write the run file /proc/run.h5"):
+        runner.run(cfg, tmp_path)
+    process = cli("disks.n=100", "output.file=/proc/run.h5", f"hydra.run.dir={tmp_path}",
+                  cwd=tmp_path)
+    _, err = process.communicate(timeout=300)
+    assert process.returncode == 1
+    assert [line for line in err.splitlines() if line.strip()][0].startswith(
+        "sim: cannot write the run file")
