@@ -262,18 +262,69 @@ def test_a_killed_run_leaves_a_readable_file(seconds, tmp_path):
         assert f["particles/disks/position/value"][frames - 1].shape == (3000, 2)
 
 
-def test_inspect_rejects_foreign_and_truncated_files(tmp_path):
+def test_inspect_and_open_run_reject_foreign_truncated_and_corrupt_files(tmp_path):
     foreign = tmp_path / "foreign.h5"
     with h5py.File(foreign, "w") as f:
         f["x"] = 1
-    with pytest.raises(RunFileError, match="not an H5MD run file"):
-        summary(foreign)
     text = tmp_path / "text.h5"
     text.write_text("hello")
-    with pytest.raises(RunFileError, match="not a readable HDF5"):
-        summary(text)
+    good = runner.run(compose_scene("gas", "disks.n=200", "stop.collisions=2000"), tmp_path)
+    truncated = tmp_path / "truncated.h5"
+    truncated.write_bytes(good.read_bytes()[: good.stat().st_size // 2])
+    corrupt = tmp_path / "corrupt.h5"
+    data = bytearray(good.read_bytes())
+    data[200:4000] = bytes(3800)  # the superblock survives, the root group's metadata not
+    corrupt.write_bytes(bytes(data))
+    for reader in (summary, open_run):
+        with pytest.raises(RunFileError, match="not an H5MD run file"):
+            reader(foreign)
+        for broken in (text, truncated):
+            with pytest.raises(RunFileError, match="not a readable HDF5"):
+                reader(broken)
+        with pytest.raises(RunFileError, match=str(corrupt)):
+            reader(corrupt)
 
 
 def test_config_error_names_key_value_and_allowed():
     error = ConfigError("restitution.disk", 1.5, "between 0 and 1")
     assert str(error) == "restitution.disk=1.5 is not allowed: between 0 and 1"
+
+
+def test_a_sweep_run_again_skips_its_complete_jobs(tmp_path):
+    args = ("scenario=crater", "projectile.radius=0.01,0.02", "bed.n=300",
+            "stop.collisions=2000", f"hydra.sweep.dir={tmp_path}/sweep", "-m")
+    first = run_cli(*args, cwd=tmp_path)
+    assert first.returncode == 0, first.stderr[-2000:]
+    files = sorted((tmp_path / "sweep").rglob("run.h5"))
+    stamps = [f.stat().st_mtime_ns for f in files]
+    again = run_cli(*args, cwd=tmp_path)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert again.stdout.count("is complete") == 2
+    assert [f.stat().st_mtime_ns for f in files] == stamps
+    summary_ = yaml.safe_load((tmp_path / "sweep" / "sweep_summary.yaml").read_text())
+    assert (summary_["completed"], summary_["failed"]) == (2, 0)
+
+
+def test_a_sweep_runs_through_submitit(tmp_path):
+    """The launcher a cluster uses (submitit; hydra/launcher=cluster on SLURM), run here with
+    its local executor."""
+    result = run_cli("scenario=crater", "projectile.radius=0.01,0.02", "bed.n=300",
+                     "stop.collisions=2000", "hydra/launcher=submitit_local",
+                     "hydra.launcher.timeout_min=10", f"hydra.sweep.dir={tmp_path}/sweep", "-m",
+                     cwd=tmp_path)
+    assert result.returncode == 0, result.stderr[-2000:]
+    summary_ = yaml.safe_load((tmp_path / "sweep" / "sweep_summary.yaml").read_text())
+    assert (summary_["completed"], summary_["failed"]) == (2, 0)
+    assert len(list((tmp_path / "sweep").rglob("run.h5"))) == 2
+
+
+def test_the_cluster_launcher_config_composes_to_slurm():
+    from hydra import compose, initialize_config_dir
+
+    from sim.__main__ import CONF_DIR
+
+    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+        cfg = compose("config", overrides=["hydra/launcher=cluster"], return_hydra_config=True)
+    launcher = cfg.hydra.launcher
+    assert launcher._target_.endswith("SlurmLauncher")
+    assert (launcher.cpus_per_task, launcher.array_parallelism) == (1, 200)

@@ -27,6 +27,7 @@ from xarray.backends import BackendArray
 from xarray.core import indexing
 
 from sim.h5md import OBSERVABLES
+from sim.inspect import DAMAGE, RunFileError, open_run_file
 
 
 class _H5Array(BackendArray):
@@ -52,7 +53,7 @@ def _lazy(dataset, dims):
 def open_run(path):
     """The run file at ``path`` as an :class:`xarray.Dataset` (see the module docstring).
     Close it with ``ds.close()`` (or use it in a ``with`` block) to release the file."""
-    f = h5py.File(path, "r")
+    f = open_run_file(path)
     try:
         disks = f["particles/disks"]
         time = disks["position/time"][()]
@@ -89,6 +90,9 @@ def open_run(path):
                    "box": box["edges"][()].tolist(),
                    "boundary": [b.decode() for b in box.attrs["boundary"]],
                    "path": str(path)})
+    except DAMAGE as error:
+        f.close()
+        raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
     except Exception:
         f.close()
         raise

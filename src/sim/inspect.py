@@ -18,16 +18,33 @@ class RunFileError(ValueError):
     """Not a readable sim run file."""
 
 
-def summary(path):
-    """A dict describing the run file at ``path``."""
+#: what a read of a damaged run file raises: h5py's errors, and HDF5's for broken metadata
+DAMAGE = (KeyError, OSError, RuntimeError, ValueError)
+
+
+def open_run_file(path):
+    """The run file at ``path`` opened for reading (an :class:`h5py.File`), or
+    :class:`RunFileError` saying why it is not one: not HDF5 (or truncated), another HDF5
+    file, or damaged."""
     try:
         f = h5py.File(path, "r")
     except (OSError, ValueError) as error:
         raise RunFileError(f"{path}: not a readable HDF5 file ({error})") from error
-    with f:
-        if "h5md" not in f or "particles/disks/position" not in f:
-            raise RunFileError(f"{path}: an HDF5 file, but not an H5MD run file of sim "
-                               f"(no /h5md or /particles/disks/position)")
+    try:
+        is_run_file = "h5md" in f and "particles/disks/position" in f
+    except RuntimeError as error:  # HDF5 finds its own metadata damaged
+        f.close()
+        raise RunFileError(f"{path}: damaged run file ({error})") from error
+    if not is_run_file:
+        f.close()
+        raise RunFileError(f"{path}: an HDF5 file, but not an H5MD run file of sim "
+                           f"(no /h5md or /particles/disks/position)")
+    return f
+
+
+def summary(path):
+    """A dict describing the run file at ``path``."""
+    with open_run_file(path) as f:
         try:
             parameters = f["parameters"].attrs
             config = yaml.safe_load(parameters["config"])
@@ -55,7 +72,7 @@ def summary(path):
                 "seed": int(parameters["seed"]),
                 "creator": f"{creator['name']} {creator['version']}",
             }
-        except (KeyError, OSError, ValueError, yaml.YAMLError) as error:
+        except (*DAMAGE, yaml.YAMLError) as error:
             raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
     if energy.size:
         # energy balance: kinetic + potential + dissipated − work of the walls stays constant;
