@@ -28,6 +28,7 @@ from scipy import stats
 
 from sim.analysis import open_sweep
 from sim.crater import calibrated_spacing, crater_area
+from sim.figures.crater_runs import require_stop
 from sim.figures.style import figure, save
 
 NAME = "fig11_crater_gravity"
@@ -67,10 +68,7 @@ def cavity_of_run(run):
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["energy"])
     speed = ds["projectile_speed"].values
-    unfinished = speed[ds["stop_reason"].values != "at_rest"]
-    if unfinished.size:
-        raise ValueError(f"runs at projectile speed {unfinished.tolist()} did not come to rest: "
-                         f"raise their stop.time")
+    require_stop(ds, "projectile_speed", "at_rest", "raise their stop.time")
     cavities = [cavity_of_run(ds.isel(projectile_speed=k)) for k in range(speed.size)]
     energy = np.array([c[0] for c in cavities])
     area = np.array([c[1].max() for c in cavities])

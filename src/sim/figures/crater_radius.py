@@ -14,7 +14,7 @@ import numpy as np
 from scipy import stats
 
 from sim.analysis import at_last_snapshot, open_sweep
-from sim.figures.crater_runs import CraterGeometry, crater_overrides
+from sim.figures.crater_runs import CraterGeometry, crater_overrides, require_stop
 from sim.figures.style import figure, save
 
 NAME = "fig09_crater_radius"
@@ -32,10 +32,7 @@ def sweeps(quick):
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["radius"])
     radius = ds["projectile_radius"].values
-    unfinished = radius[ds["stop_reason"].values != "energy_fraction"]
-    if unfinished.size:
-        raise ValueError(f"runs with projectile radius {unfinished.tolist()} ended before 10 % "
-                         f"of the energy was left: raise their stop.collisions")
+    require_stop(ds, "projectile_radius", "energy_fraction", "raise their stop.collisions")
     last = at_last_snapshot(ds, "position")
     geometry = CraterGeometry.of_run(ds.isel(projectile_radius=0))
     area = np.array([geometry.area(last.isel(projectile_radius=k).values)

@@ -15,6 +15,16 @@ def crater_overrides(quick):
     return ["scenario=crater", *bed]
 
 
+def require_stop(sweep, swept, reason, remedy):
+    """Raise when a run of ``sweep`` (over the dimension ``swept``) stopped otherwise than by
+    ``reason``: its crater would be read at another stage than the others'."""
+    values = sweep[swept].values
+    unfinished = values[sweep["stop_reason"].values != reason]
+    if unfinished.size:
+        raise ValueError(f"runs at {swept} = {unfinished.tolist()} stopped otherwise than by "
+                         f"{reason}: {remedy}")
+
+
 @dataclass
 class CraterGeometry:
     """What the crater measure needs from a run: the bed disks, the bed region and the grid
