@@ -73,14 +73,20 @@ def wall_temperature(walls):
 
 
 @njit(cache=True, inline="always")
+def wall_motion_of(wall, motion):
+    """(U, A, ω) of ``wall``: zeros for a still wall, or when no wall moves."""
+    if motion is None:
+        return 0.0, 0.0, 0.0
+    return motion[wall, 0], motion[wall, 1], motion[wall, 2]
+
+
+@njit(cache=True, inline="always")
 def wall_state(wall, t_abs, geometry, motion):
     """Position and velocity of ``wall`` at absolute time ``t_abs``."""
     rest = geometry[wall >> 1] * (wall & 1)
     if motion is None:
         return rest, 0.0
-    speed = motion[wall, 0]
-    amplitude = motion[wall, 1]
-    omega = motion[wall, 2]
+    speed, amplitude, omega = wall_motion_of(wall, motion)
     return (rest + speed * t_abs + amplitude * math.sin(omega * t_abs),
             speed + amplitude * omega * math.cos(omega * t_abs))
 
@@ -101,13 +107,7 @@ def predict_wall_contact(axis, t_abs, x, v, radius, geometry, gravity, motion, h
         wall = 2 * axis + side
         sign = 1.0 - 2.0 * side
         rest = geometry[axis] * side
-        speed = 0.0
-        amplitude = 0.0
-        omega = 0.0
-        if motion is not None:
-            speed = motion[wall, 0]
-            amplitude = motion[wall, 1]
-            omega = motion[wall, 2]
+        speed, amplitude, omega = wall_motion_of(wall, motion)
         h = sign * (x - rest - speed * t_abs) - radius
         if amplitude == 0.0:
             tau = first_contact_accelerated(h, sign * (v - speed), sign * a)
