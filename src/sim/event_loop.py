@@ -9,7 +9,8 @@ Positions are advanced lazily: disk i is stored at ``disks[i, X:Y+1]`` at its ow
 ``disks[i, T_OWN]`` (disk table columns in :mod:`sim.kinematics`). Every ``rebase_every``
 events all disks are brought to the current time and the clock restarts from zero (its
 origin kept in ``accumulators[T_ORIGIN]``), so long runs keep full float64 precision. Stale
-events are re-predicted, never applied.
+events are re-predicted, never applied. At large N the loop waits on memory: it asks the CPU
+to prefetch the partner's data and that of the next disks in the queue (:mod:`sim.prefetch`).
 
 Optional effects arrive as arguments that are either ``None`` or a value; numba compiles one
 loop per combination and removes the code of every effect that is ``None``:
@@ -30,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from sim.collision_rules import collide_disks
-from sim.event_queue import build_queue, earliest, reschedule
+from sim.event_queue import HEAP_SIZE, build_queue, earliest, reschedule
 from sim.flight import displacement, fly, position_at, velocity_at
 from sim.gravity import shell_exit
 from sim.kinematics import (
@@ -49,6 +50,7 @@ from sim.kinematics import (
 )
 from sim.neighbours import list_start, rebuild_neighbours
 from sim.parameters import per_disk
+from sim.prefetch import prefetch
 from sim.recorders import add_virial_tensor, log_contact
 from sim.walls import contact_key, hit_wall, predict_wall_contact
 
@@ -245,6 +247,18 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
             stalled = 0
             t_previous = t
         partner = event_partner[i]
+        # start loading what this event's partner and the next events' disks will need while
+        # this event is worked on (a hint only; +8 % at N = 1e6, +3 % at 1e4)
+        if partner >= 0:
+            prefetch(disks, partner)
+            prefetch(coll_count, partner)
+            prefetch(links, partner)
+            prefetch(nb, list_start(nb_start, partner))
+        for slot in range(1, min(3, calendar[HEAP_SIZE])):
+            c = heap[slot]
+            prefetch(disks, c)
+            prefetch(event_partner, c)
+            prefetch(nb, list_start(nb_start, c))
         fly(i, t, disks, geometry, grid, gravity, images)
         j = partner  # the second disk to re-predict, when it is a disk contact
         if partner >= 0 and coll_count[j] != event_count[i]:
