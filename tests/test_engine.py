@@ -98,6 +98,21 @@ def test_time_reversal_returns_to_the_start():
     assert back.collisions == 1000
 
 
+def test_construction_applies_no_event_even_at_a_contact_at_t0():
+    """The first predictions run through the event loop at t = 0; a contact due at t = 0 is
+    scheduled there and applied by run(), not by the constructor."""
+    radius = 0.05
+    position = np.array([[0.4, 0.5], [0.5, 0.5], [0.2, 0.2]])
+    velocity = np.array([[1.0, 0.0], [-1.0, 0.0], [0.3, 0.1]])
+    engine = Engine(position, velocity, radius)
+    assert (engine.events, engine.collisions, engine.time) == (0, 0, 0.0)
+    assert engine.next_event_time() == 0.0
+    np.testing.assert_array_equal(engine.velocities(), velocity)
+    engine.run(collisions=1)
+    assert engine.time == 0.0
+    np.testing.assert_array_equal(engine.velocities()[:2], velocity[[1, 0]])
+
+
 def test_stop_exactly_at_requested_time_and_positions_there():
     engine = gas(400, 0.3, seed=17)
     assert engine.run(time=0.25) == "time"

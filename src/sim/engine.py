@@ -251,12 +251,10 @@ class Engine:
         self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
                                   else float(collapse_interval))
         self.collapse_streak = int(collapse_streak)
-        self._build(position, velocity, shell, list_capacity)
-        if unwrap:
-            self.disks.images = np.zeros((n, 2), dtype=np.int32)
+        self._build(position, velocity, shell, list_capacity, unwrap)
 
     # -- construction ---------------------------------------------------------------------
-    def _build(self, position, velocity, shell, list_capacity):
+    def _build(self, position, velocity, shell, list_capacity, unwrap):
         """Size shells and cells, allocate the state, link neighbours, schedule events."""
         n, radius, box = self.n, self.radius, self.box
         median = float(np.median(radius))
@@ -315,7 +313,8 @@ class Engine:
             order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
             heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
             big=big.astype(np.int32),
-            cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32))
+            cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32),
+            images=np.zeros((n, 2), dtype=np.int32) if unwrap else None)
         self.packing_fraction = phi
         d = self.disks
         # per-disk values every disk shares (None where they differ): the compiled code gets
@@ -332,9 +331,13 @@ class Engine:
             if full < 0:
                 break
             self._grow_lists(full)
-        loop.predict_all(0.0, d.table, shell_radius, d.coll_count, d.event_time,
-                         d.event_partner, d.event_count, self._list_layout()[0], d.nb_count,
-                         d.nb, self.geometry, self.grid, self.gravity, self.wall_motion, 0.0)
+        # first predictions: every disk queued at t = 0 and predicted by the event loop itself
+        # (with the argument types of every later call) in a call that may apply no event;
+        # then the queue is sized for the predicted events
+        d.event_time[:] = 0.0
+        d.event_partner[:] = loop.UNPREDICTED
+        build_queue(*d.queue, d.event_time, 0.0)
+        self._run_chunk(0, 0, 0, 0.0, np.inf)
         build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()

@@ -4,7 +4,10 @@ Each disk owns one scheduled event, the earliest of (Smallenburg, Eur. Phys. J. 
   * a contact with a disk of its neighbour list (``partner ≥ 0``), valid while the partner's
     collision counter still equals the value recorded at prediction;
   * a contact with a wall (``partner = WALL_X_LOW … WALL_Y_HIGH``);
-  * its exit from its neighbour shell (``partner = SHELL_EXIT``), which rebuilds its list.
+  * its exit from its neighbour shell (``partner = SHELL_EXIT``), which rebuilds its list;
+  * at construction, its first prediction (``partner = UNPREDICTED``, at the current time):
+    every disk is predicted through the loop's one inlined copy of :func:`predict`, which
+    spares the compiler a second copy.
 Positions are advanced lazily: disk i is stored at ``disks[i, X:Y+1]`` at its own time
 ``disks[i, T_OWN]`` (disk table columns in :mod:`sim.kinematics`). Every ``rebase_every``
 events all disks are brought to the current time and the clock restarts from zero (its
@@ -57,6 +60,7 @@ from sim.walls import contact_key, hit_wall, predict_wall_contact
 # event partners other than a disk
 NO_EVENT = -1
 SHELL_EXIT = -2
+UNPREDICTED = -7  # a disk awaiting its first prediction, queued at the current time
 WALL_X_LOW = -3  # wall codes: WALL_X_LOW - (2 * axis + side)
 WALL_X_HIGH = -4
 WALL_Y_LOW = -5
@@ -214,22 +218,24 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     stalled = 0
     stall_limit = 16 * disks.shape[0] + 1000
     while True:
-        if events >= max_events:
-            status = STATUS_EVENT_LIMIT
-            break
-        if disk_collisions >= max_collisions:
-            status = STATUS_COLLISION_LIMIT
-            break
-        if disk_collisions + wall_collisions >= max_contacts:
-            status = STATUS_CONTACT_LIMIT
-            break
-        if dissipated_disks + dissipated_walls >= dissipation_limit:
-            status = STATUS_ENERGY_REACHED
-            break
-        if log_full:
-            status = STATUS_LOG_FULL
-            break
         i = earliest(heap, links, list_head, calendar, block_rate, event_time)
+        partner = event_partner[i]
+        if partner != UNPREDICTED:  # a first prediction is made whatever the limits
+            if events >= max_events:
+                status = STATUS_EVENT_LIMIT
+                break
+            if disk_collisions >= max_collisions:
+                status = STATUS_COLLISION_LIMIT
+                break
+            if disk_collisions + wall_collisions >= max_contacts:
+                status = STATUS_CONTACT_LIMIT
+                break
+            if dissipated_disks + dissipated_walls >= dissipation_limit:
+                status = STATUS_ENERGY_REACHED
+                break
+            if log_full:
+                status = STATUS_LOG_FULL
+                break
         t = event_time[i]
         if t > t_stop_rel:
             status = STATUS_TIME_REACHED
@@ -246,7 +252,6 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         else:
             stalled = 0
             t_previous = t
-        partner = event_partner[i]
         # start loading what this event's partner and the next events' disks will need while
         # this event is worked on (a hint only; +8 % at N = 1e6, +3 % at 1e4)
         if partner >= 0:
@@ -302,6 +307,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                     status = STATUS_COLLAPSE
                     culprit = i if streak[i] > collapse_streak else j
                     break
+        elif partner == UNPREDICTED:
+            pass  # nothing happens: the disk is only predicted below
         elif partner == SHELL_EXIT:
             full = rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb,
                                       cell_head, cell_next, cell_prev, cell_of, big, geometry,
@@ -351,8 +358,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                     nb_start, nb_count, nb, geometry, grid, gravity, motion,
                     accumulators[T_ORIGIN])
             reschedule(heap, links, list_head, calendar, block_rate, event_time, moved)
-        if partner >= 0 and j < 0:
-            continue  # a stale event is no event: the clock and the rebase count stay
+        if (partner >= 0 and j < 0) or partner == UNPREDICTED:
+            continue  # a stale event or a first prediction is no event: the clock stays
         t_now = t
         events_to_rebase -= 1
         if events_to_rebase == 0:
@@ -374,15 +381,6 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     accumulators[VIRIAL] = virial_sum
     accumulators[WALL_WORK] = wall_work
     return status, culprit
-
-
-@njit(cache=True, _nrt=False, error_model="numpy")
-def predict_all(t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
-                nb_count, nb, geometry, grid, gravity, motion, t_origin):
-    """Schedule the first event of every disk (all disks at time t)."""
-    for i in range(disks.shape[0]):
-        predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                nb_start, nb_count, nb, geometry, grid, gravity, motion, t_origin)
 
 
 @njit(cache=True)

@@ -157,7 +157,7 @@ def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta
     return found + new
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
                          nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
                          grid):
@@ -231,9 +231,9 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
     cy = disks[i, Y]
     start = list_start(nb_start, i)
     old = nb_count[i]
-    found = _find_new_neighbours(i, cx, cy, disks[i, CX], disks[i, CY], 0, disks, delta,
-                                 nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_of,
-                                 big, geometry, grid)
+    found = _find_new_neighbours(np.int64(i), cx, cy, disks[i, CX], disks[i, CY], np.int64(0),
+                                 disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
+                                 cell_next, cell_of, big, geometry, grid)
     if found < 0:
         return i
     full = _full_list(start + old, found, nb_start, nb_cap, nb_count, nb)
@@ -282,9 +282,9 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
             _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
     for i in range(n):
         first = list_start(nb_start, i) + nb_count[i]
-        found = _find_new_neighbours(i, disks[i, CX], disks[i, CY], np.nan, np.nan, i + 1,
-                                     disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
-                                     cell_next, cell_of, big, geometry, grid)
+        found = _find_new_neighbours(np.int64(i), disks[i, CX], disks[i, CY], np.nan, np.nan,
+                                     np.int64(i + 1), disks, delta, nb_start, nb_cap, nb_count,
+                                     nb, cell_head, cell_next, cell_of, big, geometry, grid)
         if found < 0:
             return i
         full = _full_list(first, found, nb_start, nb_cap, nb_count, nb)
