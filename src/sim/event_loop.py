@@ -60,11 +60,11 @@ from sim.walls import contact_key, hit_wall, predict_wall_contact
 # event partners other than a disk
 NO_EVENT = -1
 SHELL_EXIT = -2
-UNPREDICTED = -7  # a disk awaiting its first prediction, queued at the current time
 WALL_X_LOW = -3  # wall codes: WALL_X_LOW - (2 * axis + side)
 WALL_X_HIGH = -4
 WALL_Y_LOW = -5
 WALL_Y_HIGH = -6
+UNPREDICTED = -7  # a disk awaiting its first prediction, queued at the current time
 
 # loop status
 STATUS_EVENT_LIMIT = 1
