@@ -169,6 +169,10 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     within its reach. Returns the number of disks found, or -1 when they do not fit the list.
     Every candidate is written into the next free slot and the number advances only on a hit:
     no branch on the test, whose outcome the branch predictor cannot guess.
+
+    Compiled once and called, not inlined, by :func:`rebuild_neighbours` and
+    :func:`build_all_neighbours` (both pass ``i`` and ``first_candidate`` as int64, so that
+    they share one specialisation): 3.5 s less of the first compilation.
     """
     ncx = grid[0]
     ncy = grid[1]
