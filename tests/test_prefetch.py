@@ -1,10 +1,13 @@
-"""The cache hint of the event loop compiles for every array it is given and changes nothing."""
+"""The cache hints of the event loop compile for every array they are given and change
+nothing, whether they reach one or several events ahead."""
 
 import numpy as np
 import pytest
 from numba import njit
 from numba.core.errors import TypingError
 
+from sim.engine import Boundary, Engine
+from sim.initial import fixed_speed, random_sequential
 from sim.prefetch import prefetch
 
 
@@ -38,3 +41,30 @@ def test_only_arrays_take_hints():
 
     with pytest.raises(TypingError):
         hint_a_number(1.0)
+
+
+def mixed_disks(periodic, seed):
+    """600 small disks and one 8 times larger (a "big" disk, outside the cells)."""
+    radius = np.full(601, 0.008)
+    radius[0] = 0.064
+    position = random_sequential(radius, periodic=periodic, seed=seed)
+    return position, fixed_speed(601, 1.0, seed=seed + 1), radius
+
+
+@pytest.mark.parametrize("periodic", [(False, False), (True, True), (True, False)])
+def test_look_ahead_changes_no_trajectory(periodic):
+    """The hints for states larger than the caches (``lookahead``: the rows of the next
+    disks' neighbours, their partners, the cells a shell exit scans, the next bucket) leave
+    every bit of the run as it is without them."""
+    position, velocity, radius = mixed_disks(periodic, seed=4)
+    engines = [Engine(position, velocity, radius, boundary=Boundary(periodic=periodic))
+               for _ in range(2)]
+    assert not engines[0].lookahead
+    engines[1].lookahead = True
+    for engine in engines:
+        engine.run(collisions=20 * 601)
+    assert engines[0].counters.tolist() == engines[1].counters.tolist()
+    assert engines[0].collisions == 20 * 601
+    assert engines[0].disks.big.size == 1
+    np.testing.assert_array_equal(engines[0].positions(), engines[1].positions())
+    np.testing.assert_array_equal(engines[0].velocities(), engines[1].velocities())

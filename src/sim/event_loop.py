@@ -13,7 +13,8 @@ Positions are advanced lazily: disk i is stored at ``disks[i, X:Y+1]`` at its ow
 events all disks are brought to the current time and the clock restarts from zero (its
 origin kept in ``accumulators[T_ORIGIN]``), so long runs keep full float64 precision. Stale
 events are re-predicted, never applied. At large N the loop waits on memory: it asks the CPU
-to prefetch the partner's data and that of the next disks in the queue (:mod:`sim.prefetch`).
+to prefetch the partner's data and that of the next disks in the queue, and for states larger
+than the caches several events ahead (:func:`prefetch_upcoming`, :mod:`sim.prefetch`).
 
 Optional effects arrive as arguments that are either ``None`` or a value; numba compiles one
 loop per combination and removes the code of every effect that is ``None``:
@@ -34,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from sim.collision_rules import collide_disks
-from sim.event_queue import HEAP_SIZE, build_queue, earliest, reschedule
+from sim.event_queue import HEAP_SIZE, build_queue, earliest, prefetch_next_block, reschedule
 from sim.flight import displacement, fly, position_at, velocity_at
 from sim.gravity import shell_exit
 from sim.kinematics import (
@@ -51,7 +52,7 @@ from sim.kinematics import (
     pair_contact_time,
     wrap,
 )
-from sim.neighbours import list_start, rebuild_neighbours
+from sim.neighbours import list_start, prefetch_cells, rebuild_neighbours
 from sim.parameters import per_disk
 from sim.prefetch import prefetch
 from sim.recorders import add_virial_tensor, log_contact
@@ -144,6 +145,61 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
 
 
 @njit(cache=True, inline="always")
+def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, coll_count, event_time,
+                      event_partner, event_count, heap, links, list_head, calendar, nb_start,
+                      nb_count, nb, cell_head, cell_next, geometry, grid):
+    """Ask the CPU to start loading what the next events will read while this one is worked on
+    (hints only: no result changes). A disk's data is hinted in stages, one event apart, each
+    stage reading what the one before brought in: the partner of this event and the disks of
+    the next two in the heap (heap slots 1, 2); with ``lookahead``, also the third, and for the
+    next two the rows their predictions read (their neighbours'), their partners' data, or the
+    cells a shell exit scans, and the bucket that becomes the heap next
+    (:func:`sim.event_queue.prefetch_next_block`). Returns the bucket walk's state.
+
+    Against the hints without ``lookahead`` (``benchmarks/compare_builds.py``, φ = 0.5): 1.49
+    at N = 1e5, 1.39 at 1e6, 1.11 at 5e4, but 0.94 at 3e4, where the state still sits mostly
+    in cache (hence :data:`sim.engine.LOOKAHEAD_MIN_DISKS`).
+    """
+    if partner >= 0:
+        prefetch(disks, partner)
+        prefetch(coll_count, partner)
+        prefetch(links, partner)
+        start = list_start(nb_start, partner)
+        prefetch(nb, start)
+        if lookahead:
+            for k in range(start, start + nb_count[partner]):
+                prefetch(disks, nb[k])
+    size = calendar[HEAP_SIZE]
+    for slot in range(1, min(4 if lookahead else 3, size)):
+        c = heap[slot]
+        prefetch(disks, c)
+        prefetch(event_partner, c)
+        prefetch(nb, list_start(nb_start, c))
+        if lookahead:
+            prefetch(event_count, c)
+            prefetch(coll_count, c)
+            prefetch(links, c)
+    if not lookahead:
+        return walker, walker_block
+    for slot in range(1, min(3, size)):
+        c = heap[slot]
+        start = list_start(nb_start, c)
+        for k in range(start, start + nb_count[c]):
+            prefetch(disks, nb[k])
+        partner_c = event_partner[c]
+        if partner_c >= 0:
+            prefetch(disks, partner_c)
+            prefetch(nb, list_start(nb_start, partner_c))
+            prefetch(nb_count, partner_c)
+            prefetch(coll_count, partner_c)
+            prefetch(event_count, partner_c)
+        elif partner_c == SHELL_EXIT:
+            prefetch_cells(disks[c, X], disks[c, Y], slot == 1, disks, cell_head, cell_next,
+                           geometry, grid)
+    return prefetch_next_block(walker, walker_block, links, list_head, calendar, event_time)
+
+
+@njit(cache=True, inline="always")
 def count_contacts(coll_count, contacts):
     """Bring the full contact counts ``contacts`` int64[n] up to date with the counters
     ``coll_count`` int32[n], which wrap at 2³²: correct while no disk makes 2³² contacts
@@ -183,7 +239,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                seed, images, virial_tensor, event_log, log_fill,
                counters, accumulators, pair_collisions, wall_impulse,
                max_events, max_contacts, max_collisions, t_stop, dissipation_limit,
-               collapse_dt, collapse_streak, rebase_every):
+               collapse_dt, collapse_streak, rebase_every, lookahead):
     """Process events in time order until a limit is met; see the module docstring.
 
     Limits: ``max_events`` (applied events, shell exits included: the chunk size),
@@ -194,6 +250,9 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     consecutive dissipative contacts, each less than ``collapse_dt`` after its previous
     contact (contacts made elastic by the TC model break the streak). A stall — more than
     16 N + 1000 events in a row at one instant — ends the loop instead of hanging it.
+
+    ``lookahead``: prefetch several events ahead, for states larger than the caches
+    (:func:`prefetch_upcoming`).
 
     Counters and accumulators live in local variables (registers) during the loop and are
     written back to ``counters`` and ``accumulators`` when it stops.
@@ -217,6 +276,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     t_previous = -INF
     stalled = 0
     stall_limit = 16 * disks.shape[0] + 1000
+    walker = -1  # the queue's look-ahead (prefetch_next_block)
+    walker_block = -1
     while True:
         i = earliest(heap, links, list_head, calendar, block_rate, event_time)
         partner = event_partner[i]
@@ -252,18 +313,10 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         else:
             stalled = 0
             t_previous = t
-        # start loading what this event's partner and the next events' disks will need while
-        # this event is worked on (a hint only; +8 % at N = 1e6, +3 % at 1e4)
-        if partner >= 0:
-            prefetch(disks, partner)
-            prefetch(coll_count, partner)
-            prefetch(links, partner)
-            prefetch(nb, list_start(nb_start, partner))
-        for slot in range(1, min(3, calendar[HEAP_SIZE])):
-            c = heap[slot]
-            prefetch(disks, c)
-            prefetch(event_partner, c)
-            prefetch(nb, list_start(nb_start, c))
+        walker, walker_block = prefetch_upcoming(
+            partner, lookahead, walker, walker_block, disks, coll_count, event_time,
+            event_partner, event_count, heap, links, list_head, calendar, nb_start, nb_count, nb,
+            cell_head, cell_next, geometry, grid)
         fly(i, t, disks, geometry, grid, gravity, images)
         j = partner  # the second disk to re-predict, when it is a disk contact
         if partner >= 0 and coll_count[j] != event_count[i]:

@@ -32,6 +32,8 @@ Arrays (n disks, B buckets):
 import numpy as np
 from numba import njit
 
+from sim.prefetch import prefetch
+
 # columns of ``links``
 SLOT = 0
 NEXT = 1
@@ -160,6 +162,28 @@ def reschedule(heap, links, list_head, calendar, block_rate, event_time, disk):
     else:
         _list_unlink(links, list_head, disk)
     _insert(heap, links, list_head, calendar, block_rate, event_time, disk)
+
+
+@njit(cache=True, inline="always")
+def prefetch_next_block(walker, walker_block, links, list_head, calendar, event_time):
+    """Walk the bucket of the block after the current one, one disk per call, and hint the
+    cache for the links and event time of each, so that they are at hand when that bucket
+    becomes the heap (:func:`_refill_heap` walks the bucket and sifts by event time).
+
+    ``walker`` is the disk reached (-1: none), ``walker_block`` the block walked; returns both
+    updated. Each step reads the links the previous call asked for. A disk that leaves the
+    bucket meanwhile leads the walk astray, which costs a useless hint and nothing else.
+    """
+    next_block = calendar[CURRENT_BLOCK] + 1
+    if next_block != walker_block:
+        walker_block = next_block
+        walker = list_head[next_block & (list_head.shape[0] - 2)]
+    elif walker >= 0:
+        walker = links[walker, NEXT]
+    if walker >= 0:
+        prefetch(links, walker)
+        prefetch(event_time, walker)
+    return walker, walker_block
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")

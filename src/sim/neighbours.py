@@ -36,6 +36,7 @@ from numba.extending import overload
 
 from sim.kinematics import CX, CY, RADIUS, X, Y, minimum_image
 from sim.parameters import per_disk
+from sim.prefetch import prefetch
 
 
 def list_start(nb_start, i):
@@ -205,6 +206,33 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
         if found < 0:
             return -1
     return found
+
+
+@njit(cache=True, inline="always")
+def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
+    """Hint the cache for a rebuild of a small disk's list near (x, y), which scans the 3×3
+    cells around it (:func:`_find_new_neighbours`). Without ``members``: the heads of those
+    cells. With ``members``: the heads are read (they should be in cache by now) and the
+    first disks of each cell are hinted, the head and the disk before it (cells are filed in
+    increasing disk order after a renumbering, so a cell's disks are mostly consecutive)."""
+    ncx = grid[0]
+    ncy = grid[1]
+    c = cell_index(x, y, geometry, grid)
+    x_lo, x_hi = _axis_span(c % ncx, 1, ncx, grid[2] != 0)
+    y_lo, y_hi = _axis_span(c // ncx, 1, ncy, grid[3] != 0)
+    for ay in range(y_lo, y_hi):
+        row = _fold(ay, ncy) * ncx
+        if not members:
+            prefetch(cell_head, row + _fold(x_lo, ncx))
+            prefetch(cell_head, row + _fold(x_hi - 1, ncx))
+            continue
+        for ax in range(x_lo, x_hi):
+            j = cell_head[row + _fold(ax, ncx)]
+            if j >= 0:
+                prefetch(disks, j)
+                prefetch(cell_next, j)
+                if j > 0:
+                    prefetch(disks, j - 1)
 
 
 @njit(cache=True, inline="always")
