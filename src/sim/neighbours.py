@@ -212,9 +212,9 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
 def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
     """Hint the cache for a rebuild of a small disk's list near (x, y), which scans the 3×3
     cells around it (:func:`_find_new_neighbours`). Without ``members``: the heads of those
-    cells. With ``members``: the heads are read (they should be in cache by now) and the
-    first disks of each cell are hinted, the head and the disk before it (cells are filed in
-    increasing disk order after a renumbering, so a cell's disks are mostly consecutive)."""
+    cells. With ``members``: the heads are read (they should be in cache by now) and for each
+    cell the head and the disk numbered before it are hinted (after a renumbering by cell the
+    disks of a cell carry consecutive numbers, so that one is mostly a cell-mate)."""
     ncx = grid[0]
     ncy = grid[1]
     c = cell_index(x, y, geometry, grid)
