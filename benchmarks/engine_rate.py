@@ -161,19 +161,16 @@ def main(argv=None):
               f"{os.cpu_count()} cores, Python {platform.python_version()}, one thread")
 
 
-COLUMNS = ["scene", "n", "phi", "collisions_per_s", "events_per_s", "bytes_per_disk",
-           "rss_bytes_per_disk", "compile_s", "reference_ratio"]
-
-
 def emit(row, as_json, header=False):
+    """Print a row (a dict) as one JSON object, or as a line of a Markdown table whose header
+    (the row's keys) comes first when ``header``; None prints as an empty cell."""
     if as_json:
         print(json.dumps(row), flush=True)
         return
     if header:
-        print(" | ".join(COLUMNS))
-        print(" | ".join("---" for _ in COLUMNS))
-    print(" | ".join("" if row[c] is None else str(row[c]) for c in COLUMNS), flush=True)
-
+        print(" | ".join(row))
+        print(" | ".join("---" for _ in row))
+    print(" | ".join("" if v is None else str(v) for v in row.values()), flush=True)
 
 if __name__ == "__main__":
     main()

@@ -12,11 +12,12 @@ in advance (``sim.event_loop.prefetch_upcoming``) costs the time printed for the
 """
 
 import argparse
-import json
 import time
 
 import numpy as np
 from numba import njit
+
+from engine_rate import emit
 
 LINE_WORDS = 8  # int64 words per 64-byte cache line
 
@@ -56,15 +57,9 @@ def main(argv=None):
     parser.add_argument("--steps", type=int, default=2_000_000, help="dependent loads timed")
     parser.add_argument("--json", action="store_true", help="one JSON object per row")
     args = parser.parse_args(argv)
-    if not args.json:
-        print("working set (MiB) | ns per dependent load")
-        print("--- | ---")
-    for mib in args.mib:
-        ns = latency_ns(mib, args.steps)
-        if args.json:
-            print(json.dumps({"mib": mib, "ns_per_load": round(ns, 1)}), flush=True)
-        else:
-            print(f"{mib:g} | {ns:.1f}", flush=True)
+    for k, mib in enumerate(args.mib):
+        emit({"mib": mib, "ns_per_load": round(latency_ns(mib, args.steps), 1)}, args.json,
+             header=k == 0)
 
 
 if __name__ == "__main__":

@@ -14,12 +14,12 @@ the rest of a collision on the disks themselves; set it beside ``collisions_per_
 """
 
 import argparse
-import json
 import time
 
 import numpy as np
 from numba import njit
 
+from engine_rate import emit
 from sim.event_queue import build_queue, earliest, empty_queue, reschedule
 
 #: Partners are drawn within ±NEIGHBOUR_SPAN / 2 ids of the disk.
@@ -68,13 +68,8 @@ def main(argv=None):
     parser.add_argument("--steps", type=int, default=5_000_000, help="collisions replayed")
     parser.add_argument("--json", action="store_true", help="one JSON object per N")
     args = parser.parse_args(argv)
-    if not args.json:
-        print("n | queue_ns_per_collision")
-        print("--- | ---")
-    for n in args.n:
-        row = queue_row(n, args.steps)
-        print(json.dumps(row) if args.json else " | ".join(str(v) for v in row.values()),
-              flush=True)
+    for k, n in enumerate(args.n):
+        emit(queue_row(n, args.steps), args.json, header=k == 0)
 
 
 if __name__ == "__main__":
