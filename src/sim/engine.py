@@ -20,11 +20,11 @@ import numpy as np
 from sim import event_loop as loop
 from sim.event_queue import build_queue, empty_queue
 from sim.gravity import gravity_vector, potential_energy
-from sim.kinematics import RADIUS, T_OWN, VX, VY, X, Y
+from sim.kinematics import DISK_COLUMNS, RADIUS, T_OWN, VX, VY, X, Y
 from sim.neighbours import build_all_neighbours, grow_lists, list_starts
 from sim.parameters import common_value
 from sim.recorders import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
-from sim.state import DiskArrays, disk_table
+from sim.state import DiskArrays
 from sim.walls import wall_motion, wall_state, wall_temperature
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
@@ -304,7 +304,7 @@ class Engine:
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
         minus_one = np.full(n, -1, dtype=np.int32)
         heap, links, list_head, calendar, block_rate = empty_queue(n)
-        table = disk_table(n)
+        table = np.zeros((n, DISK_COLUMNS))
         table[:, X:Y + 1] = position
         table[:, VX:VY + 1] = velocity
         table[:, RADIUS] = radius
@@ -370,6 +370,7 @@ class Engine:
             disks = np.arange(self.n)  # all alike, so that they stay alike
         d.nb_start, d.nb_cap, d.nb_count, d.nb = grow_lists(d.nb_start, d.nb_cap, d.nb_count,
                                                             d.nb, disks)
+        d.pack()
         self._common_capacity = common_value(d.nb_cap)
 
     def reorder(self):
