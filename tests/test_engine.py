@@ -177,6 +177,32 @@ def test_large_systems_renumber_as_they_run():
     assert_no_overlap(engine)
 
 
+def state_buffer_span(disks):
+    """(first byte, end byte) of the state's non-empty arrays, asserting each starts on a
+    cache line."""
+    spans = []
+    for name, array in disks.arrays().items():
+        if array.size == 0:
+            continue
+        start = array.__array_interface__["data"][0]
+        assert start % 64 == 0, name
+        spans.append((start, start + array.nbytes))
+    return min(s for s, _ in spans), max(e for _, e in spans)
+
+
+def test_state_stays_in_one_buffer_through_renumbering_and_list_growth():
+    """One buffer, on a 2 MiB boundary, each array on a cache line (sim.state.one_buffer),
+    also after a renumbering and after the lists grow."""
+    engine = gas(800, 0.6, (True, True), seed=37, list_capacity=1)
+    for change in (lambda: None, engine.reorder, lambda: engine._grow_lists(0)):
+        change()
+        first, end = state_buffer_span(engine.disks)
+        assert first % (2 << 20) == 0
+        assert end - first < engine.disks.nbytes + 64 * len(engine.disks.arrays())
+    engine.run(collisions=5_000)
+    assert_no_overlap(engine)
+
+
 def test_rebased_clock_keeps_the_trajectory():
     """Restarting the clock every few events does not change the physics beyond round-off."""
     a = gas(300, 0.3, (True, True), seed=29)

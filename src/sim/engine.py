@@ -302,25 +302,8 @@ class Engine:
             density = max(phi_small, 0.6) / (np.pi * median**2)
             reach_big = radius[big] + delta[big] + reach
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
-        minus_one = np.full(n, -1, dtype=np.int32)
-        heap, links, list_head, calendar, block_rate = empty_queue(n)
-        table = np.zeros((n, DISK_COLUMNS))
-        table[:, X:Y + 1] = position
-        table[:, VX:VY + 1] = velocity
-        table[:, RADIUS] = radius
-        self.disks = DiskArrays(
-            table=table, delta=delta, mass=self.mass.copy(), species=self.species.copy(),
-            is_big=is_big, coll_count=np.zeros(n, np.int32), contacts=np.zeros(n, np.int64),
-            t_last=np.full(n, -np.inf),
-            streak=np.zeros(n, np.int32), event_time=np.empty(n),
-            event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int32),
-            links=links, nb_start=list_starts(cap), nb_cap=cap, nb_count=np.zeros(n, np.int32),
-            cell_next=minus_one.copy(), cell_prev=minus_one.copy(), cell_of=minus_one.copy(),
-            order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
-            heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
-            big=big.astype(np.int32),
-            cell_head=np.full(int(cells[0] * cells[1]), -1, dtype=np.int32),
-            images=np.zeros((n, 2), dtype=np.int32) if unwrap else None)
+        self.disks = self._initial_state(position, velocity, radius, delta, is_big, big, cap,
+                                         int(cells[0] * cells[1]), unwrap)
         self.packing_fraction = phi
         d = self.disks
         # per-disk values every disk shares (None where they differ): the compiled code gets
@@ -347,6 +330,32 @@ class Engine:
         build_queue(*d.queue, d.event_time, 0.0)
         if n >= REORDER_MIN_DISKS:
             self.reorder()
+
+    def _initial_state(self, position, velocity, radius, delta, is_big, big, cap, n_cells,
+                       unwrap):
+        """The state arrays before any list is built or event predicted (:mod:`sim.state`);
+        its own function, so that the arrays it makes are freed once they are copied into
+        the state's buffer."""
+        n = self.n
+        minus_one = np.full(n, -1, dtype=np.int32)
+        heap, links, list_head, calendar, block_rate = empty_queue(n)
+        table = np.zeros((n, DISK_COLUMNS))
+        table[:, X:Y + 1] = position
+        table[:, VX:VY + 1] = velocity
+        table[:, RADIUS] = radius
+        return DiskArrays(
+            table=table, delta=delta, mass=self.mass.copy(), species=self.species.copy(),
+            is_big=is_big, coll_count=np.zeros(n, np.int32), contacts=np.zeros(n, np.int64),
+            t_last=np.full(n, -np.inf),
+            streak=np.zeros(n, np.int32), event_time=np.empty(n),
+            event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int32),
+            links=links, nb_start=list_starts(cap), nb_cap=cap, nb_count=np.zeros(n, np.int32),
+            cell_next=minus_one.copy(), cell_prev=minus_one.copy(), cell_of=minus_one.copy(),
+            order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
+            heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
+            big=big.astype(np.int32),
+            cell_head=np.full(n_cells, -1, dtype=np.int32),
+            images=np.zeros((n, 2), dtype=np.int32) if unwrap else None)
 
     def _per_disk_parameters(self):
         """Shell radius, mass and species as the compiled loop takes them: the number every

@@ -331,10 +331,14 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
 
 
 @njit(cache=True)
-def _copy_lists(nb_start, nb_count, nb, new_start, new_nb):
-    for i in range(nb_start.shape[0]):
-        for k in range(nb_count[i]):
-            new_nb[new_start[i] + k] = nb[nb_start[i] + k]
+def copy_lists(order, new_id, nb_start, nb_count, nb, new_start, new_nb):
+    """Write into ``new_nb`` at ``new_start[k]`` the list of disk ``order[k]``, each entry j
+    as ``new_id[j]``: lists moved to a new layout (identity ``order`` and ``new_id``) or
+    renumbered, without temporary arrays."""
+    for k in range(order.shape[0]):
+        i = order[k]
+        for m in range(nb_count[i]):
+            new_nb[new_start[k] + m] = new_id[nb[nb_start[i] + m]]
 
 
 def list_starts(capacity):
@@ -358,5 +362,6 @@ def grow_lists(nb_start, nb_cap, nb_count, nb, disks):
     new_cap[disks] *= 2
     new_start = list_starts(new_cap)
     new_nb = np.full(int(new_cap.sum(dtype=np.int64)), -1, dtype=np.int32)
-    _copy_lists(nb_start, nb_count, nb, new_start, new_nb)
+    identity = np.arange(nb_start.size)
+    copy_lists(identity, identity, nb_start, nb_count, nb, new_start, new_nb)
     return new_start, new_cap, nb_count, new_nb
