@@ -7,7 +7,8 @@ import pytest
 
 from conftest import assert_no_overlap, gas
 from sim.audit import overlapping_pairs
-from sim.engine import Boundary, Engine, InelasticCollapseError
+from sim.engine import (Boundary, Engine, InelasticCollapseError,
+                        packing_fraction_around_disks, shell_ratio)
 from sim.initial import PlacementError, hexagonal_lattice, random_sequential
 
 
@@ -201,6 +202,26 @@ def test_state_stays_in_one_buffer_through_renumbering_and_list_growth():
         assert end - first < engine.disks.nbytes + 64 * len(engine.disks.arrays())
     engine.run(collisions=5_000)
     assert_no_overlap(engine)
+
+
+def test_shells_follow_the_packing_fraction_around_the_disks():
+    """A gas filling the box sees the box's φ; a bed filling its lower half sees twice that,
+    and gets the shells of its own density (the crater bed); under 64 disks, the box's φ."""
+    radius = 0.0045
+    box = np.array([1.0, 1.0])
+    gas_fill = random_sequential(np.full(4000, radius), seed=1)
+    bed = random_sequential(np.full(4000, radius), region=((0, 1), (0, 0.5)), seed=1)
+    phi_box = 4000 * np.pi * radius**2
+    assert packing_fraction_around_disks(gas_fill, np.full(4000, radius), box) == pytest.approx(
+        phi_box, rel=0.03)
+    phi_bed = packing_fraction_around_disks(bed, np.full(4000, radius), box)
+    assert phi_bed == pytest.approx(2 * phi_box, rel=0.05)
+    few = gas_fill[:50]
+    assert packing_fraction_around_disks(few, np.full(50, radius), box) == pytest.approx(
+        50 * np.pi * radius**2, rel=1e-12)
+    engine = Engine(bed, np.zeros((4000, 2)), radius)
+    reach = radius + 0.5 * (shell_ratio(phi_bed) - 1.0) * 2.0 * radius
+    assert engine.geometry[4] == pytest.approx(reach, rel=1e-12)
 
 
 def test_rebased_clock_keeps_the_trajectory():

@@ -43,9 +43,12 @@ def test_quick_figures(tmp_path):
     radius = np.loadtxt(out / "fig09_crater_radius.csv", delimiter=",", skiprows=1)
     assert np.all(np.diff(radius[:, 2]) > 0)  # larger projectiles dig larger craters
     speed = np.loadtxt(out / "fig10_crater_speed.csv", delimiter=",", skiprows=1)
-    # no energy scale: the same area at every speed, but for the TC model's fixed t_c
+    # no energy scale: the same area at every speed, but for the TC model's fixed t_c, which
+    # makes each speed's run another realization: at one speed the area scatters by 4.7 %
+    # from seed to seed (standard deviation of 6 seeds, this quick bed), so three runs may
+    # spread by up to about 4 standard deviations; a trend with speed would exceed that
     for column in (2, 5):
-        assert np.ptp(speed[:, column]) < 0.05 * speed[:, column].mean()
+        assert np.ptp(speed[:, column]) < 0.2 * speed[:, column].mean()
     gravity = np.loadtxt(out / "fig11_crater_gravity.csv", delimiter=",", skiprows=1)
     assert np.all(np.diff(gravity[:, 2]) > 0)  # more energy opens a larger cavity
     assert np.all(gravity[:, 3] < 0.5 * gravity[:, 2])  # which mostly closes again
