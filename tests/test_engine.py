@@ -7,8 +7,13 @@ import pytest
 
 from conftest import assert_no_overlap, gas
 from sim.audit import overlapping_pairs
-from sim.engine import (Boundary, Engine, InelasticCollapseError,
-                        packing_fraction_around_disks, shell_ratio)
+from sim.engine import (
+    Boundary,
+    Engine,
+    InelasticCollapseError,
+    packing_fraction_around_disks,
+    shell_ratio,
+)
 from sim.initial import PlacementError, hexagonal_lattice, random_sequential
 
 
