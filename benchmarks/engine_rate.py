@@ -172,5 +172,6 @@ def emit(row, as_json, header=False):
         print(" | ".join("---" for _ in row))
     print(" | ".join("" if v is None else str(v) for v in row.values()), flush=True)
 
+
 if __name__ == "__main__":
     main()
