@@ -131,10 +131,10 @@ def packing_fraction_around_disks(position, radius, box):
     counts per bin (at most 1/DISKS_PER_BIN for an ideal gas, 0.4 % for hard disks at
     φ = 0.5); for a bed filling part of the box (the crater) it is the bed's φ, not the
     box's. Shells and list capacities sized by it: the crater bed of
-    ``benchmarks/engine_rate.py`` (φ = 0.25 in the box, 0.49 in the bed) gets shells of 2.04 σ instead of 3.06 σ and lists of 24 instead of
-    48 (grown from 24 as they overflowed), and ran 1.1–1.3× faster, with the projectile in
-    1.5–2.7× (both shells run side by side, three pairs of runs). Fewer than 64 disks: the
-    box's φ.
+    ``benchmarks/engine_rate.py`` (φ = 0.25 in the box, 0.49 in the bed) gets shells of
+    2.04 σ instead of 3.06 σ and lists of 24 instead of 48 (grown from 24 as they
+    overflowed), and ran 1.1–1.3× faster, with the projectile in 1.5–2.7× (both shells run
+    side by side, three pairs of runs). Fewer than 64 disks: the box's φ.
 
     position float64[n, 2], radius float64[n], box (Lx, Ly): same length unit.
     """
