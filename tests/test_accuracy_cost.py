@@ -24,12 +24,17 @@ def test_quick_study_writes_every_knob_and_behaves(tmp_path):
         assert (tmp_path / f"{name}.nc").exists() and (tmp_path / f"{name}.png").exists()
     assert (tmp_path / "pareto.png").exists() and (tmp_path / "summary.md").exists()
     knob = {name: xr.open_dataset(tmp_path / f"{name}.nc") for name in study.KNOBS}
-    # finite size: 64 disks are measurably off, 1024 within their 2σ bar plus 0.2 %
+    # finite size: every N agrees with Kolafa–Rottner within its 2σ bar plus 0.2 %, and the
+    # bar falls as 1/√N (×4 from 64 to 1024 disks); at 64 disks the 2σ bar (about 1 %) hides
+    # the finite-size shift, so which of two errors is larger is chance
     n = knob["n_disks"]
-    assert n["error"][0] > n["error"][-1]
-    assert n["error"][-1] < n["error_bar"][-1] + 0.002
-    # the statistical error bar of Z falls with the collisions sampled, roughly as 1/√C
-    c = knob["collisions"]
+    assert np.all(n["error"] < n["error_bar"] + 0.002)
+    assert n["error_bar"][0] > 2.5 * n["error_bar"][-1]
+    # the statistical error bar of Z falls with the collisions sampled, roughly as 1/√C, once
+    # it is estimated from 10 blocks or more (blocks of 10 collisions per disk: C ≥ 100; the
+    # scatter of 2 or 5 block means says little about their spread)
+    c = knob["collisions"].where(knob["collisions"]["setting"] >= 100, drop=True)
+    assert c["setting"].size >= 3
     slope = np.polyfit(np.log(c["setting"]), np.log(c["error_bar"]), 1)[0]
     assert -0.8 < slope < -0.3
     # equal speeds relax: kurtosis 1 (error 0.5) at the start, near 2 after 8 per disk

@@ -14,7 +14,10 @@ from sim.engine import (
     packing_fraction_around_disks,
     shell_ratio,
 )
+from sim.event_loop import SHELL_EXITS
 from sim.initial import PlacementError, hexagonal_lattice, random_sequential
+from sim.kinematics import DISK_COLUMNS, VX, VY, X, Y
+from sim.neighbours import shell_centre
 
 
 def triangle_wave(s, low, high):
@@ -227,6 +230,43 @@ def test_shells_follow_the_packing_fraction_around_the_disks():
     engine = Engine(bed, np.zeros((4000, 2)), radius)
     reach = radius + 0.5 * (shell_ratio(phi_bed) - 1.0) * 2.0 * radius
     assert engine.geometry[4] == pytest.approx(reach, rel=1e-12)
+
+
+def test_shell_centre_leads_its_disk_by_a_fraction_of_the_shell():
+    """λ δ ahead along the velocity, wrapped on a periodic axis; a disk at rest or too slow
+    ever to reach its shell is centred on itself."""
+    disks = np.zeros((4, DISK_COLUMNS))
+    disks[:, X:Y + 1] = [[0.5, 0.5], [0.5, 0.5], [0.5, 0.5], [0.998, 0.5]]
+    disks[:, VX:VY + 1] = [[3.0, -4.0], [1e-150, 0.0], [0.0, 0.0], [2.0, 0.0]]
+    geometry = np.array([1.0, 1.0, 0.1, 0.1, 0.05, 0.8])
+    grid = np.array([10, 10, 1, 0])
+    delta = 0.01
+    assert shell_centre(0, disks, delta, geometry, grid) == pytest.approx(
+        (0.5 + 0.008 * 0.6, 0.5 - 0.008 * 0.8), abs=1e-15)
+    assert shell_centre(1, disks, delta, geometry, grid) == (0.5, 0.5)
+    assert shell_centre(2, disks, delta, geometry, grid) == (0.5, 0.5)
+    assert shell_centre(3, disks, delta, geometry, grid) == pytest.approx((0.006, 0.5),
+                                                                          abs=1e-15)
+
+
+@pytest.mark.parametrize("periodic", [(True, True), (False, False)])
+def test_shells_ahead_of_their_disks_save_exits_and_change_no_physics(periodic):
+    """A new shell centred λ δ ahead of its disk (:func:`sim.neighbours.shell_centre`): in a
+    dilute gas fewer shell exits per collision than with shells centred on the disk (2.09
+    against 1.41 per collision at φ = 0.1, N = 1e4), the same collisions at the same times,
+    no overlap."""
+    centred = gas(2000, 0.1, periodic, seed=3, shell_lead=0.0)
+    ahead = gas(2000, 0.1, periodic, seed=3, shell_lead=0.8)
+    for engine in (centred, ahead):
+        engine.run(collisions=4000)
+    assert ahead.counters[SHELL_EXITS] < 0.8 * centred.counters[SHELL_EXITS]
+    assert ahead.time == pytest.approx(centred.time, rel=1e-12)
+    assert ahead.wall_collisions == centred.wall_collisions
+    d = ahead.positions(centred.time) - centred.positions(centred.time)
+    assert np.abs(d - np.round(d) if periodic[0] else d).max() < 1e-9
+    assert_no_overlap(ahead)
+    with pytest.raises(ValueError, match="shell_lead"):
+        gas(50, 0.1, periodic, shell_lead=1.0)
 
 
 def test_rebased_clock_keeps_the_trajectory():

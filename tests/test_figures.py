@@ -51,7 +51,11 @@ def test_quick_figures(tmp_path):
         assert np.ptp(speed[:, column]) < 0.2 * speed[:, column].mean()
     gravity = np.loadtxt(out / "fig11_crater_gravity.csv", delimiter=",", skiprows=1)
     assert np.all(np.diff(gravity[:, 2]) > 0)  # more energy opens a larger cavity
-    assert np.all(gravity[:, 3] < 0.5 * gravity[:, 2])  # which mostly closes again
+    # a cavity larger than the projectile (radius 0.05) mostly closes again; a smaller one
+    # is of the size of the dent every impact leaves (0.0015-0.003 in this quick bed)
+    opened = gravity[:, 2] > np.pi * 0.05**2
+    assert opened.sum() >= 2
+    assert np.all(gravity[opened, 3] < 0.5 * gravity[opened, 2])
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
     main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])

@@ -52,7 +52,7 @@ from sim.kinematics import (
     pair_contact_time,
     wrap,
 )
-from sim.neighbours import list_start, prefetch_cells, rebuild_neighbours
+from sim.neighbours import list_start, prefetch_cells, rebuild_neighbours, shell_centre
 from sim.parameters import per_disk
 from sim.prefetch import prefetch
 from sim.recorders import add_virial_tensor, log_contact
@@ -145,9 +145,9 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
 
 
 @njit(cache=True, inline="always")
-def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, coll_count, event_time,
-                      event_partner, event_count, heap, links, list_head, calendar, nb_start,
-                      nb_count, nb, cell_head, cell_next, geometry, grid):
+def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, coll_count,
+                      event_time, event_partner, event_count, heap, links, list_head, calendar,
+                      nb_start, nb_count, nb, cell_head, cell_next, geometry, grid):
     """Ask the CPU to start loading what the next events will read while this one is worked on
     (hints only: no result changes). A disk's data is hinted in stages, one event apart, each
     stage reading what the one before brought in: the partner of this event and the disks of
@@ -194,8 +194,8 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, coll_coun
             prefetch(coll_count, partner_c)
             prefetch(event_count, partner_c)
         elif partner_c == SHELL_EXIT:
-            prefetch_cells(disks[c, X], disks[c, Y], slot == 1, disks, cell_head, cell_next,
-                           geometry, grid)
+            cx, cy = shell_centre(c, disks, delta, geometry, grid)
+            prefetch_cells(cx, cy, slot == 1, disks, cell_head, cell_next, geometry, grid)
     return prefetch_next_block(walker, walker_block, links, list_head, calendar, event_time)
 
 
@@ -314,7 +314,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
             stalled = 0
             t_previous = t
         walker, walker_block = prefetch_upcoming(
-            partner, lookahead, walker, walker_block, disks, coll_count, event_time,
+            partner, lookahead, walker, walker_block, disks, delta, coll_count, event_time,
             event_partner, event_count, heap, links, list_head, calendar, nb_start, nb_count, nb,
             cell_head, cell_next, geometry, grid)
         fly(i, t, disks, geometry, grid, gravity, images)

@@ -7,7 +7,9 @@ shell-exit event, disk i stays inside the shell, so i and j can only touch while
 kept symmetric: when i rebuilds, it leaves the lists of the neighbours it loses and joins the
 lists of the ones it gains.
 
-The grid files disks by shell centre, so a disk changes cell only when it rebuilds. Cells are
+A new shell is centred a little ahead of its disk along its velocity (:func:`shell_centre`),
+so that in a dilute gas a disk flies further before it leaves. The grid files disks by shell
+centre, so a disk changes cell only when it rebuilds. Cells are
 sized for the ordinary ("small") disks. The few disks much larger than the rest ("big", e.g. a
 crater projectile) are not filed in cells: every small disk checks them directly, and a big
 disk scans as many cells as its reach needs. So one projectile never forces large cells on
@@ -24,7 +26,8 @@ Arrays (n disks):
   loaded, and the neighbours of a disk are one load closer;
   cell_head int32[ncx*ncy], cell_next int32[n], cell_prev int32[n], cell_of int32[n] (-1 big);
   big int32[n_big];
-  geometry float64[5] = (Lx, Ly, cell width x, cell width y, largest small R + δ);
+  geometry float64[6] = (Lx, Ly, cell width x, cell width y, largest small R + δ, lead λ of
+  :func:`shell_centre`);
   grid int64[4] = (cells along x, cells along y, periodic x, periodic y).
 """
 
@@ -34,7 +37,18 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from sim.kinematics import CX, CY, RADIUS, X, Y, minimum_image
+from sim.kinematics import (
+    CX,
+    CY,
+    RADIUS,
+    TINY_SPEED_SQUARED,
+    VX,
+    VY,
+    X,
+    Y,
+    minimum_image,
+    wrap,
+)
 from sim.parameters import per_disk
 from sim.prefetch import prefetch
 
@@ -236,6 +250,25 @@ def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
 
 
 @njit(cache=True, inline="always")
+def shell_centre(i, disks, delta, geometry, grid):
+    """Centre (cx, cy) of a new shell for disk i: ahead of the disk along its velocity by
+    λ δ_i, λ = ``geometry[5]`` < 1, wrapped into a periodic box.
+
+    Any centre within δ_i of the disk is valid; one ahead of a disk in free flight lets it
+    cross (1 + λ) δ_i instead of δ_i before it leaves the shell, so a dilute gas, whose disks
+    fly further than δ between collisions, rebuilds fewer lists. A disk at rest, or too slow
+    ever to reach its shell (``TINY_SPEED_SQUARED``), is centred on itself.
+    """
+    vx = disks[i, VX]
+    vy = disks[i, VY]
+    speed_squared = vx * vx + vy * vy
+    lead = (geometry[5] * per_disk(delta, i) / math.sqrt(speed_squared)
+            if speed_squared > TINY_SPEED_SQUARED else 0.0)
+    return (wrap(disks[i, X] + lead * vx, geometry[0], grid[2] != 0),
+            wrap(disks[i, Y] + lead * vy, geometry[1], grid[3] != 0))
+
+
+@njit(cache=True, inline="always")
 def _full_list(first, found, nb_start, nb_cap, nb_count, nb):
     """The first disk among ``nb[first : first + found]`` whose list is full, or -1."""
     for k in range(first, first + found):
@@ -259,8 +292,7 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
     are lists changed and the shell moved. On overflow (returned disk id ≥ 0) nothing has
     changed, and calling again after enlarging the lists does the rebuild.
     """
-    cx = disks[i, X]
-    cy = disks[i, Y]
+    cx, cy = shell_centre(i, disks, delta, geometry, grid)
     start = list_start(nb_start, i)
     old = nb_count[i]
     found = _find_new_neighbours(np.int64(i), cx, cy, disks[i, CX], disks[i, CY], np.int64(0),
