@@ -8,6 +8,7 @@ import pytest
 from conftest import assert_no_overlap, gas
 from sim.audit import overlapping_pairs
 from sim.engine import (
+    LIST_GROWTH,
     Boundary,
     Engine,
     InelasticCollapseError,
@@ -152,7 +153,10 @@ def test_same_inputs_same_bits_whatever_the_chunking():
 def test_full_neighbour_lists_grow_without_changing_the_physics():
     roomy = gas(800, 0.6, (True, True), seed=37)
     tight = gas(800, 0.6, (True, True), seed=37, list_capacity=1)
-    assert tight.disks.nb_cap.max() > 1  # grown while the lists were first built
+    # grown while the lists were first built, all alike and by LIST_GROWTH entries at a time
+    capacity = tight.disks.nb_cap
+    assert capacity[0] > 1 and np.all(capacity == capacity[0])
+    assert (capacity[0] - 1) % LIST_GROWTH == 0
     roomy.run(collisions=40_000)
     tight.run(collisions=40_000)
     assert tight.time == pytest.approx(roomy.time, rel=1e-12)

@@ -385,13 +385,12 @@ def list_starts(capacity):
     return starts
 
 
-def grow_lists(nb_start, nb_cap, nb_count, nb, disks):
-    """Return enlarged neighbour arrays: the lists of ``disks`` double their capacity.
+def grow_lists(nb_start, nb_count, nb, new_cap):
+    """Return enlarged neighbour arrays (start, capacity, count, lists) for the capacities
+    ``new_cap`` int32[n], each at least the old one.
 
     Contents and counts are kept; a rare step, done between compiled calls.
     """
-    new_cap = nb_cap.copy()
-    new_cap[disks] *= 2
     new_start = list_starts(new_cap)
     new_nb = np.full(int(new_cap.sum(dtype=np.int64)), -1, dtype=np.int32)
     identity = np.arange(nb_start.size)
