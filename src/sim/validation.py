@@ -186,45 +186,53 @@ def cooling_gas(n, phi, restitution, seed, tc=None, mass=1.0, species=None):
     return engine, radius
 
 
-def haff_cooling(restitution, n=4000, phi=0.1, seed=5, longest=60.0):
+def haff_cooling(restitution, n=4000, phi=0.1, seed=5, runs=8, longest=60.0):
     """Homogeneous cooling: E(C)/E₀ against exp(−(1 − ξ²) C/N) at C/N = 1/(1 − ξ²) (E/E₀ = 1/e),
     and T(t)/T₀ against Haff's 1/(1 + t/t₀)², t₀ = 4/((1 − ξ²) ω₀) with Enskog's ω₀ (χ from
-    Kolafa–Rottner), at t = t₀ (T/T₀ = 1/4). Then the run goes on, up to C/N = ``longest``,
-    to find where E(C) first departs by more than 5 % from the exponential.
+    Kolafa–Rottner), at t = t₀ (T/T₀ = 1/4), each the mean over ``runs`` realizations (seeds
+    ``seed``, ``seed + 1``, …). Then every run goes on, up to C/N = ``longest``, to find where
+    E(C) first departs by more than 5 % from the exponential (the median over runs).
 
-    Tolerances: 2 % on E(C) (the Sonine correction a₂ is below 1 % for ξ ≥ 0.7) and 4 % on T(t)
-    (Enskog's rate with the equilibrium χ sets t₀, and the early growth of the instability
-    already slows the cooling by about 1 % per collision at C/N ≈ 5). The departure is the
-    clustering instability of a box larger than 2√π/(nσ√(1 − ξ²)): dense clusters collide
-    less often per unit energy lost than the homogeneous gas, so the cooling slows.
+    Tolerances: 3 % on E(C) and 5 % on T(t₀). The Sonine correction a₂ is below 1 % for
+    ξ ≥ 0.7, but the early growth of the instability already slows the cooling, and Enskog's
+    rate with the equilibrium χ sets t₀: over 20 runs of 4000 disks (seeds 200 … 219) E(C)
+    lay 1.3 % (ξ = 0.9) and 1.9 % (ξ = 0.8) above exp(−1), T(t₀) 1.9 % and 3.3 % above 1/4,
+    with standard deviations of 0.8–1.2 % from run to run: 0.3–0.4 % for a mean of 8. The
+    departure is the clustering instability of a box larger than 2√π/(nσ√(1 − ξ²)): dense
+    clusters collide less often per unit energy lost than the homogeneous gas, so the cooling
+    slows.
     """
     started = time.perf_counter()
-    engine, radius = cooling_gas(n, phi, restitution, seed)
-    e0 = engine.kinetic_energy()
     rate = 1.0 - restitution**2
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
-    t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, e0 / (n - 1)))
-    engine.run(collisions=round(n / rate))  # E/E₀ = 1/e comes before T/T₀ = 1/4
-    energy_at_c = engine.kinetic_energy() / e0
-    engine.run(time=t0)
-    temperature_at_t0 = engine.kinetic_energy() / e0
-    departure = math.nan
-    for c_per_n in np.arange(math.ceil(engine.collisions / n), longest + 1.0):
-        engine.run(collisions=round(c_per_n * n))
-        if engine.kinetic_energy() / e0 > 1.05 * math.exp(-rate * engine.collisions / n):
-            departure = engine.collisions / n
-            break
+    energy_at_c, temperature_at_t0, departure = [], [], []
+    for realization in range(runs):
+        engine, radius = cooling_gas(n, phi, restitution, seed + realization)
+        e0 = engine.kinetic_energy()
+        t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, e0 / (n - 1)))
+        engine.run(collisions=round(n / rate))  # E/E₀ = 1/e comes before T/T₀ = 1/4
+        energy_at_c.append(engine.kinetic_energy() / e0)
+        engine.run(time=t0)
+        temperature_at_t0.append(engine.kinetic_energy() / e0)
+        departure.append(math.inf)
+        for c_per_n in np.arange(math.ceil(engine.collisions / n), longest + 1.0):
+            engine.run(collisions=round(c_per_n * n))
+            if engine.kinetic_energy() / e0 > 1.05 * math.exp(-rate * engine.collisions / n):
+                departure[-1] = engine.collisions / n
+                break
     seconds = time.perf_counter() - started
     box_limit = 2.0 * math.sqrt(math.pi) / (n * 2.0 * radius * math.sqrt(rate))
-    where = (f"beyond C/N = {longest:.0f}" if math.isnan(departure)
-             else f"at C/N = {departure:.0f}")
+    median_departure = float(np.median(departure))
+    where = (f"beyond C/N = {longest:.0f}" if math.isinf(median_departure)
+             else f"at C/N = {median_departure:.0f}")
     return [
-        Check(f"Haff E(C)/E₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, φ = {phi}",
-              energy_at_c, math.exp(-1.0), 0.02 * math.exp(-1.0),
-              f"exp(−(1−ξ²)C/N); departs by 5 % {where}, box 1 > instability length "
+        Check(f"Haff E(C)/E₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, φ = {phi}, "
+              f"mean of {runs} runs", float(np.mean(energy_at_c)), math.exp(-1.0),
+              0.03 * math.exp(-1.0),
+              f"exp(−(1−ξ²)C/N); departs by 5 % {where} (median), box 1 > instability length "
               f"{box_limit:.2f}", seconds),
-        Check(f"Haff T(t₀)/T₀, ξ = {restitution}", temperature_at_t0, 0.25, 0.04 * 0.25,
-              "T₀/(1 + t/t₀)², Enskog ω₀", None),
+        Check(f"Haff T(t₀)/T₀, ξ = {restitution}", float(np.mean(temperature_at_t0)), 0.25,
+              0.05 * 0.25, "T₀/(1 + t/t₀)², Enskog ω₀", None),
     ]
 
 
