@@ -1,7 +1,7 @@
 """Neighbour shells, their lists, and the cell grid used to build them.
 
 Design after Smallenburg, Eur. Phys. J. E 45, 22 (2022): disk i owns a shell, the circle of
-radius ``delta[i]`` around its centre c_i (its position when the list was last built). Until its
+radius ``delta[i]`` around its centre c_i (set when the list was last built). Until its
 shell-exit event, disk i stays inside the shell, so i and j can only touch while
 ``|c_i - c_j| < R_i + R_j + δ_i + δ_j``. The neighbour lists hold exactly those pairs and are
 kept symmetric: when i rebuilds, it leaves the lists of the neighbours it loses and joins the
@@ -9,11 +9,10 @@ lists of the ones it gains.
 
 A new shell is centred a little ahead of its disk along its velocity (:func:`shell_centre`),
 so that in a dilute gas a disk flies further before it leaves. The grid files disks by shell
-centre, so a disk changes cell only when it rebuilds. Cells are
-sized for the ordinary ("small") disks. The few disks much larger than the rest ("big", e.g. a
-crater projectile) are not filed in cells: every small disk checks them directly, and a big
-disk scans as many cells as its reach needs. So one projectile never forces large cells on
-everyone.
+centre, so a disk changes cell only when it rebuilds. Cells are sized for the ordinary
+("small") disks. The few disks much larger than the rest ("big", e.g. a crater projectile)
+are not filed in cells: every small disk checks them directly, and a big disk scans as many
+cells as its reach needs. So one projectile never forces large cells on everyone.
 
 Arrays (n disks):
   disks float64[n, DISK_COLUMNS] — the disk table of :mod:`sim.kinematics`, whose columns
