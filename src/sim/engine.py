@@ -125,16 +125,21 @@ def _closing_time(motion, box, periodic, largest_radius):
     return closing
 
 
+def _interpolate(table, packing_fraction):
+    """The value of a table of (φ, value) pairs at ``packing_fraction``, linearly
+    interpolated and held constant beyond its ends."""
+    phis, values = zip(*table, strict=True)
+    return float(np.interp(packing_fraction, phis, values))
+
+
 def shell_ratio(packing_fraction):
     """Default neighbour-shell diameter r_n in units of the contact distance σ."""
-    phis, ratios = zip(*SHELL_TABLE, strict=True)
-    return float(np.interp(packing_fraction, phis, ratios))
+    return _interpolate(SHELL_TABLE, packing_fraction)
 
 
 def shell_lead(packing_fraction):
     """Default lead λ of a new shell's centre ahead of its disk, in shell radii δ."""
-    phis, leads = zip(*LEAD_TABLE, strict=True)
-    return float(np.interp(packing_fraction, phis, leads))
+    return _interpolate(LEAD_TABLE, packing_fraction)
 
 
 #: Disks per bin, on average, of :func:`packing_fraction_around_disks`.
