@@ -447,8 +447,8 @@ class Engine:
             new_cap[np.union1d([full], np.flatnonzero(d.nb_count >= d.nb_cap))] *= 2
         else:
             new_cap = d.nb_cap + np.int32(LIST_GROWTH)
-        d.nb_start, d.nb_cap, d.nb_count, d.nb = grow_lists(d.nb_start, d.nb_count, d.nb,
-                                                            new_cap)
+        d.nb_start, d.nb = grow_lists(d.nb_start, d.nb_count, d.nb, new_cap)
+        d.nb_cap = new_cap
         d.pack()
         self._common_capacity = common_value(d.nb_cap)
 

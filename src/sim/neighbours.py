@@ -385,13 +385,11 @@ def list_starts(capacity):
 
 
 def grow_lists(nb_start, nb_count, nb, new_cap):
-    """Return enlarged neighbour arrays (start, capacity, count, lists) for the capacities
-    ``new_cap`` int32[n], each at least the old one.
-
-    Contents and counts are kept; a rare step, done between compiled calls.
-    """
+    """Return the list starts and lists (``nb_start``, ``nb``) laid out anew for the
+    capacities ``new_cap`` int32[n], each at least the old one; contents and counts are kept.
+    A rare step, done between compiled calls."""
     new_start = list_starts(new_cap)
     new_nb = np.full(int(new_cap.sum(dtype=np.int64)), -1, dtype=np.int32)
     identity = np.arange(nb_start.size)
     copy_lists(identity, identity, nb_start, nb_count, nb, new_start, new_nb)
-    return new_start, new_cap, nb_count, new_nb
+    return new_start, new_nb
