@@ -87,7 +87,7 @@ def reference_rate(position, velocity, radius, events):
     return (reference.collisions - c0) / (time.perf_counter() - started)
 
 
-def gas_row(n, phi, collisions, warmup, reference_events, chunks=1, **effects):
+def gas_row(n, phi, collisions, warmup, reference_events, chunks, **effects):
     rss_before = peak_rss_bytes()
     position, velocity, radius = equal_disks(n, phi)
     engine = build(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
