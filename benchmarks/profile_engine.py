@@ -27,27 +27,27 @@ TOOLS = ("perf", "nm", "objdump")
 
 
 def compiled_functions(folder):
-    """Every compiled specialisation of sim's functions: (name, address, size, machine code
-    as ``objdump`` lines of (offset, instruction)), one entry per address."""
+    """Every compiled specialisation of sim's functions, each found in the module that
+    defines it: (name, address, size, machine code as (offset, instruction) pairs). The
+    machine code comes from numba's private ``_get_compiled_object``, which only code compiled
+    in this process has."""
     from numba.core.registry import CPUDispatcher
 
-    found = {}
+    found = []
     for module_name, module in list(sys.modules.items()):
-        if not module_name.startswith("sim"):
+        if module_name != "sim" and not module_name.startswith("sim."):
             continue
         for attribute, value in vars(module).items():
             if not isinstance(value, CPUDispatcher) or value.__module__ != module_name:
                 continue
             for k, compiled in enumerate(value.overloads.values()):
                 symbol = compiled.fndesc.llvm_func_name
-                address = compiled.library.get_pointer_to_function(symbol)
-                if address in found:
-                    continue
                 obj = Path(folder) / f"{module_name}.{attribute}.{k}.o"
                 obj.write_bytes(compiled.library._get_compiled_object())
-                found[address] = (f"{module_name}.{attribute}", address,
-                                  *_disassemble(obj, symbol))
-    return list(found.values())
+                found.append((f"{module_name}.{attribute}",
+                              compiled.library.get_pointer_to_function(symbol),
+                              *_disassemble(obj, symbol)))
+    return found
 
 
 def _disassemble(obj, symbol):
