@@ -171,6 +171,31 @@ def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta
     return found + new
 
 
+@njit(cache=True, inline="always")
+def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid):
+    """Hint the cache for the row of every disk filed in the cells of a scan (spans of
+    :func:`_axis_span`), before the scan reads them.
+
+    The scan walks each cell's linked list and tests every disk it meets, so without hints
+    its loads of the disks' rows wait one after another, as far as the CPU can run ahead of
+    the tests. Walking the lists first, which costs little (``cell_next`` is small and mostly
+    in cache), asks for all rows at once. Against the scan without it
+    (``benchmarks/compare_builds.py``, on a day the machine waited 210–250 ns on memory beyond
+    4 MiB): 1.18 at N = 1e5 and 1.16 at 1e6, φ = 0.5; 1.33 and 1.12 at 1e5, φ = 0.1 and 0.7;
+    1.10, 1.19 and 1.02 at 1e4, φ = 0.5, 0.1 and 0.7; 0.98 at 1e3 (quartiles 0.94–1.08),
+    whose state sits in cache.
+    """
+    ncx = grid[0]
+    ncy = grid[1]
+    for ay in range(y_lo, y_hi):
+        row = _fold(ay, ncy) * ncx
+        for ax in range(x_lo, x_hi):
+            j = cell_head[row + _fold(ax, ncx)]
+            while j >= 0:
+                prefetch(disks, j)
+                j = cell_next[j]
+
+
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
                          nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
@@ -202,6 +227,7 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[3] != 0)
     free = list_start(nb_start, i) + nb_count[i]
     room = per_disk(nb_cap, i) - nb_count[i]
+    _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid)
     found = 0
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
