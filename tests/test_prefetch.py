@@ -54,8 +54,8 @@ def mixed_disks(periodic, seed):
 @pytest.mark.parametrize("periodic", [(False, False), (True, True), (True, False)])
 def test_look_ahead_changes_no_trajectory(periodic):
     """The hints for states larger than the caches (``lookahead``: the rows of the next
-    disks' neighbours, their partners, the cells a shell exit scans, the next bucket) leave
-    every bit of the run as it is without them."""
+    disks' neighbours, their partners, the cells a shell exit scans and the lists it edits,
+    the next bucket) leave every bit of the run as it is without them."""
     position, velocity, radius = mixed_disks(periodic, seed=4)
     engines = [Engine(position, velocity, radius, boundary=Boundary(periodic=periodic))
                for _ in range(2)]

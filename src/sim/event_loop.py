@@ -35,7 +35,14 @@ import numpy as np
 from numba import njit
 
 from sim.collision_rules import collide_disks
-from sim.event_queue import HEAP_SIZE, build_queue, earliest, prefetch_next_block, reschedule
+from sim.event_queue import (
+    HEAP_SIZE,
+    build_queue,
+    earliest,
+    prefetch_bucket,
+    prefetch_next_block,
+    reschedule,
+)
 from sim.flight import displacement, fly, position_at, velocity_at
 from sim.gravity import shell_exit
 from sim.kinematics import (
@@ -98,10 +105,12 @@ N_ACCUMULATORS = 6
 
 
 @njit(cache=True, inline="always")
-def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_count, nb_start,
-            nb_count, nb, geometry, grid, gravity, motion, t_origin):
-    """Schedule the earliest event of disk i, which must be at time t already (``t_origin``:
-    the absolute time of the clock's zero, which moving walls need)."""
+def predict(i, t, disks, delta, coll_count, nb_start, nb_count, nb, geometry, grid, gravity,
+            motion, t_origin):
+    """The earliest event of disk i, which must be at time t already (``t_origin``: the
+    absolute time of the clock's zero, which moving walls need): its time, its partner (a
+    disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's collision count when
+    the partner is a disk (else 0), for :func:`set_event`."""
     px = grid[2] != 0
     py = grid[3] != 0
     x = disks[i, X]
@@ -138,22 +147,32 @@ def predict(i, t, disks, delta, coll_count, event_time, event_partner, event_cou
             partner = j
     if tau == INF:
         partner = NO_EVENT
-    event_time[i] = t + tau
+    return t + tau, partner, coll_count[partner] if partner >= 0 else np.int32(0)
+
+
+@njit(cache=True, inline="always")
+def set_event(i, when, partner, partner_count, event_time, event_partner, event_count):
+    """Record the event :func:`predict` found for disk i; filing it in the queue
+    (:func:`sim.event_queue.reschedule`) comes after."""
+    event_time[i] = when
     event_partner[i] = partner
     if partner >= 0:
-        event_count[i] = coll_count[partner]
+        event_count[i] = partner_count
 
 
 @njit(cache=True, inline="always")
 def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, coll_count,
                       event_time, event_partner, event_count, heap, links, list_head, calendar,
-                      nb_start, nb_count, nb, cell_head, cell_next, geometry, grid):
+                      nb_start, nb_count, nb, cell_head, cell_next, cell_prev, cell_of, geometry,
+                      grid):
     """Ask the CPU to start loading what the next events will read while this one is worked on
     (hints only: no result changes). A disk's data is hinted in stages, one event apart, each
     stage reading what the one before brought in: the partner of this event and the disks of
     the next two in the heap (heap slots 1, 2); with ``lookahead``, also the third, and for the
-    next two the rows their predictions read (their neighbours'), their partners' data, or the
-    cells a shell exit scans, and the bucket that becomes the heap next
+    next two the rows their predictions read (their neighbours' rows and collision counts),
+    their partners' data, or, for a shell exit, the cells it scans, its own cell links and the
+    lists and counts of its neighbours, which its rebuild edits; and the bucket that becomes
+    the heap next
     (:func:`sim.event_queue.prefetch_next_block`: one of its disks per event, whose row,
     partner and list are hinted too, for the first events of the next block would otherwise
     reach the heap top with nothing fetched). Returns the bucket walk's state.
@@ -163,7 +182,11 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
     in cache (hence :data:`sim.engine.LOOKAHEAD_MIN_DISKS`). The hints for the walked disks'
     rows, partners and lists, with blocks of 8 mean event times instead of 4
     (:data:`sim.event_queue.BLOCK_EVENTS`), against neither: 1.07, 1.12 and 1.11 at N = 1e5
-    (quartiles of rounds 0.98–1.17, 1.04–1.22, 1.05–1.17), 1.05 at 1e6 (1.02–1.12).
+    (quartiles of rounds 0.98–1.17, 1.04–1.22, 1.05–1.17), 1.05 at 1e6 (1.02–1.12). The
+    hints for the neighbours' collision counts, the list lengths and a shell exit's cell links
+    and edited lists, with the loop's :func:`sim.event_queue.prefetch_bucket`, against none of
+    them (on a day a miss took 200 ns): 1.135 at N = 1e5 (1.03–1.20), 1.26 at φ = 0.1, 1.20
+    at 1e6 (1.13–1.33).
     """
     if partner >= 0:
         prefetch(disks, partner)
@@ -174,6 +197,7 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
         if lookahead:
             for k in range(start, start + nb_count[partner]):
                 prefetch(disks, nb[k])
+                prefetch(coll_count, nb[k])
     size = calendar[HEAP_SIZE]
     for slot in range(1, min(4 if lookahead else 3, size)):
         c = heap[slot]
@@ -184,14 +208,19 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
             prefetch(event_count, c)
             prefetch(coll_count, c)
             prefetch(links, c)
+            prefetch(nb_count, c)
     if not lookahead:
         return walker, walker_block
     for slot in range(1, min(3, size)):
         c = heap[slot]
+        partner_c = event_partner[c]
         start = list_start(nb_start, c)
         for k in range(start, start + nb_count[c]):
             prefetch(disks, nb[k])
-        partner_c = event_partner[c]
+            prefetch(coll_count, nb[k])
+            if partner_c == SHELL_EXIT:
+                prefetch(nb, list_start(nb_start, nb[k]))
+                prefetch(nb_count, nb[k])
         if partner_c >= 0:
             prefetch(disks, partner_c)
             prefetch(nb, list_start(nb_start, partner_c))
@@ -199,6 +228,8 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
             prefetch(coll_count, partner_c)
             prefetch(event_count, partner_c)
         elif partner_c == SHELL_EXIT:
+            prefetch(cell_of, c)
+            prefetch(cell_prev, c)
             cx, cy = shell_centre(c, disks, delta, geometry, grid)
             prefetch_cells(cx, cy, slot == 1, disks, cell_head, cell_next, geometry, grid)
     walker, walker_block = prefetch_next_block(walker, walker_block, links, list_head,
@@ -207,6 +238,7 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
         prefetch(disks, walker)
         prefetch(event_partner, walker)
         prefetch(nb, list_start(nb_start, walker))
+        prefetch(nb_count, walker)
     return walker, walker_block
 
 
@@ -327,7 +359,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         walker, walker_block = prefetch_upcoming(
             partner, lookahead, walker, walker_block, disks, delta, coll_count, event_time,
             event_partner, event_count, heap, links, list_head, calendar, nb_start, nb_count, nb,
-            cell_head, cell_next, geometry, grid)
+            cell_head, cell_next, cell_prev, cell_of, geometry, grid)
         fly(i, t, disks, geometry, grid, gravity, images)
         j = partner  # the second disk to re-predict, when it is a disk contact
         if partner >= 0 and coll_count[j] != event_count[i]:
@@ -414,14 +446,26 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                     status = STATUS_COLLAPSE
                     culprit = i
                     break
-        # one call site each for predict and reschedule: numba inlines them wherever they are
-        # called, and with one copy instead of five the loop compiles about four times faster
-        for k in range(1 if j < 0 else 2):
-            moved = i if k == 0 else j
-            predict(moved, t, disks, delta, coll_count, event_time, event_partner, event_count,
-                    nb_start, nb_count, nb, geometry, grid, gravity, motion,
-                    accumulators[T_ORIGIN])
-            reschedule(heap, links, list_head, calendar, block_rate, event_time, moved)
+        # One call site each for predict and reschedule: numba inlines them wherever they are
+        # called, and with one copy instead of five the loop compiles about four times faster.
+        # Both disks are predicted before either is filed, so that the bucket head a filing
+        # reads is on its way while the second prediction runs (no prediction reads the
+        # queue). The queue sees one event time change at a time, as a filing compares times:
+        # the event of j is recorded only once i is filed.
+        moved_disks = 1 if j < 0 else 2
+        when, whom, whose_count = INF, NO_EVENT, np.int32(0)
+        for k in range(moved_disks):
+            when, whom, whose_count = predict(i if k == 0 else j, t, disks, delta, coll_count,
+                                              nb_start, nb_count, nb, geometry, grid, gravity,
+                                              motion, accumulators[T_ORIGIN])
+            prefetch_bucket(list_head, calendar, block_rate, when)
+            if k == 0:
+                set_event(i, when, whom, whose_count, event_time, event_partner, event_count)
+        for k in range(moved_disks):
+            if k == 1:  # the prediction of j, the last one made
+                set_event(j, when, whom, whose_count, event_time, event_partner, event_count)
+            reschedule(heap, links, list_head, calendar, block_rate, event_time,
+                       i if k == 0 else j)
         if (partner >= 0 and j < 0) or partner == UNPREDICTED:
             continue  # a stale event or a first prediction is no event: the clock stays
         t_now = t

@@ -168,6 +168,16 @@ def reschedule(heap, links, list_head, calendar, block_rate, event_time, disk):
 
 
 @njit(cache=True, inline="always")
+def prefetch_bucket(list_head, calendar, block_rate, t):
+    """Hint the cache for the head of the bucket that filing an event at time t reads
+    (:func:`reschedule`). A new event may fall in any of the B ≈ N buckets, whose heads
+    (int32[B + 1]) are mostly out of cache at large N; events beyond the year are not hinted."""
+    block = t * block_rate[0]
+    if calendar[CURRENT_BLOCK] < block < calendar[YEAR_END]:
+        prefetch(list_head, np.int64(block) & (list_head.shape[0] - 2))
+
+
+@njit(cache=True, inline="always")
 def prefetch_next_block(walker, walker_block, links, list_head, calendar, event_time):
     """Walk the bucket of the block after the current one, one disk per call, and hint the
     cache for the links and event time of each, so that they are at hand when that bucket

@@ -1,0 +1,63 @@
+"""The calendar queue stays what :mod:`sim.event_queue` says it is while the engine runs:
+a valid heap of the current block's events, every other event in the bucket of its block or
+in the overflow list, each disk queued exactly once, and no listed event before a heap event.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from sim.engine import Boundary, Engine
+from sim.event_queue import CURRENT_BLOCK, HEAP_SIZE, NEXT, NOT_IN_HEAP, PREV, SLOT, YEAR_END
+from sim.initial import fixed_speed, random_sequential
+
+
+def assert_queue_consistent(disks):
+    heap, links, list_head, calendar, block_rate = disks.queue
+    event_time = disks.event_time
+    size = int(calendar[HEAP_SIZE])
+    current_block = int(calendar[CURRENT_BLOCK])
+    year_end = int(calendar[YEAR_END])
+    overflow = list_head.shape[0] - 1
+    in_heap = heap[:size]
+    for k in range(size):
+        assert links[in_heap[k], SLOT] == k
+        assert math.floor(event_time[in_heap[k]] * block_rate[0]) <= current_block
+        if k > 0:
+            assert event_time[in_heap[k]] >= event_time[in_heap[(k - 1) // 2]]
+    listed = []
+    for bucket in range(overflow + 1):
+        disk, previous = list_head[bucket], -1 - bucket
+        while disk >= 0:
+            assert links[disk, SLOT] == NOT_IN_HEAP and links[disk, PREV] == previous
+            block = event_time[disk] * block_rate[0]
+            if bucket == overflow:
+                assert block >= year_end
+            else:
+                assert current_block < math.floor(block) < year_end
+                assert math.floor(block) % overflow == bucket
+            listed.append(disk)
+            disk, previous = links[disk, NEXT], disk
+    queued = np.concatenate([in_heap, np.array(listed, dtype=in_heap.dtype)])
+    assert np.array_equal(np.sort(queued), np.arange(event_time.shape[0]))
+    if size and listed:
+        assert event_time[in_heap].max() <= event_time[listed].min()
+
+
+@pytest.mark.parametrize("periodic, lookahead", [
+    ((True, True), False), ((False, False), False), ((True, False), True)])
+def test_queue_stays_consistent(periodic, lookahead):
+    """Checked after every chunk of a run of equal disks at φ ≈ 0.4, a third of them fast (so
+    that events of the next blocks, the buckets and the overflow list are all in use), with
+    and without the look-ahead hints."""
+    n = 500
+    radius = np.full(n, 0.012)
+    position = random_sequential(radius, periodic=periodic, seed=2)
+    velocity = fixed_speed(n, 1.0, seed=3)
+    velocity[::3] *= 20.0
+    engine = Engine(position, velocity, radius, boundary=Boundary(periodic=periodic))
+    engine.lookahead = lookahead
+    for chunk in range(1, 41):
+        engine.run(events=chunk * 250)
+        assert_queue_consistent(engine.disks)
