@@ -27,7 +27,13 @@ from numba import njit
 from engine_rate import equal_disks
 from sim.engine import Boundary, Engine, shell_ratio
 from sim.event_queue import build_queue, earliest, empty_queue, reschedule
-from sim.kinematics import minimum_image, pair_contact_time, shell_exit_time, wrap
+from sim.kinematics import (
+    may_touch_before,
+    minimum_image,
+    pair_contact_time,
+    shell_exit_time,
+    wrap,
+)
 
 SHELL_EXIT = -2
 
@@ -53,10 +59,13 @@ def predict(i, t, p, nb, nb_count, count, event_time, partner, partner_count, le
         dt = t - p[j, 4]
         rx = minimum_image(x - p[j, 0] - p[j, 2] * dt, length, True)
         ry = minimum_image(y - p[j, 1] - p[j, 3] * dt, length, True)
-        tau_ij = pair_contact_time(rx, ry, vx - p[j, 2], vy - p[j, 3], sigma)
-        if tau_ij < tau:
-            tau = tau_ij
-            best = j
+        vx_ij = vx - p[j, 2]
+        vy_ij = vy - p[j, 3]
+        if may_touch_before(rx, ry, vx_ij, vy_ij, sigma, tau):
+            tau_ij = pair_contact_time(rx, ry, vx_ij, vy_ij, sigma)
+            if tau_ij < tau:
+                tau = tau_ij
+                best = j
     event_time[i] = t + tau
     partner[i] = best
     if best >= 0:

@@ -6,7 +6,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from sim.kinematics import pair_contact_time, shell_exit_time, wall_contact_time
+from sim.kinematics import (
+    may_touch_before,
+    pair_contact_time,
+    shell_exit_time,
+    wall_contact_time,
+)
 
 finite = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
@@ -45,6 +50,25 @@ def test_pair_contact_time_is_never_negative_and_solves_contact(rx, ry, vx, vy, 
     if math.isfinite(tau) and rx * rx + ry * ry >= sigma * sigma:
         distance = math.hypot(rx + vx * tau, ry + vy * tau)
         assert distance == pytest.approx(sigma, rel=1e-9, abs=1e-9)
+
+
+@given(finite, finite, finite, finite, st.floats(0.01, 5.0),
+       st.one_of(st.floats(0.0, 100.0), st.just(math.inf)))
+def test_a_pair_the_filter_drops_touches_no_sooner(rx, ry, vx, vy, sigma, tau):
+    """may_touch_before drops only pairs whose contact time is not below τ (to round-off),
+    and with τ = ∞ it keeps every pair that ever touches."""
+    tau_contact = pair_contact_time(rx, ry, vx, vy, sigma)
+    if not may_touch_before(rx, ry, vx, vy, sigma, tau):
+        assert tau_contact >= tau * (1.0 - 1e-12)
+    if math.isinf(tau):
+        assert may_touch_before(rx, ry, vx, vy, sigma, tau) or math.isinf(tau_contact)
+
+
+def test_the_filter_drops_a_far_pair_and_keeps_an_overlap():
+    # head-on, gap 2 closed at speed 1: contact at τ = 2, bound c / (-2b) = 8 / 6
+    assert may_touch_before(3.0, 0.0, -1.0, 0.0, 1.0, 2.5)
+    assert not may_touch_before(3.0, 0.0, -1.0, 0.0, 1.0, 1.0)
+    assert may_touch_before(1.0 - 1e-15, 0.0, -1.0, 0.0, 1.0, 0.0)
 
 
 @given(st.floats(-0.5, 0.5), st.floats(-0.5, 0.5), finite, finite)

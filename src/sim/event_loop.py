@@ -55,6 +55,7 @@ from sim.kinematics import (
     VY,
     X,
     Y,
+    may_touch_before,
     minimum_image,
     pair_contact_time,
     wrap,
@@ -141,10 +142,14 @@ def predict(i, t, disks, delta, coll_count, nb_start, nb_count, nb, geometry, gr
                            geometry[0], px)
         ry = minimum_image(y - disks[j, Y] - displacement(j, 1, dt, disks, gravity),
                            geometry[1], py)
-        tau_ij = pair_contact_time(rx, ry, vx - vx_j, vy - vy_j, r_i + disks[j, RADIUS])
-        if tau_ij < tau:
-            tau = tau_ij
-            partner = j
+        vx_ij = vx - vx_j
+        vy_ij = vy - vy_j
+        sigma = r_i + disks[j, RADIUS]
+        if may_touch_before(rx, ry, vx_ij, vy_ij, sigma, tau):
+            tau_ij = pair_contact_time(rx, ry, vx_ij, vy_ij, sigma)
+            if tau_ij < tau:
+                tau = tau_ij
+                partner = j
     if tau == INF:
         partner = NO_EVENT
     return t + tau, partner, coll_count[partner] if partner >= 0 else np.int32(0)
