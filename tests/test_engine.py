@@ -15,7 +15,7 @@ from sim.engine import (
     packing_fraction_around_disks,
     shell_ratio,
 )
-from sim.event_loop import SHELL_EXITS
+from sim.event_loop import SHELL_EXITS, STALE_EVENTS
 from sim.initial import PlacementError, hexagonal_lattice, random_sequential
 from sim.kinematics import DISK_COLUMNS, VX, VY, X, Y
 from sim.neighbours import shell_centre
@@ -273,6 +273,19 @@ def test_shells_ahead_of_their_disks_save_exits_and_change_no_physics(periodic):
         gas(50, 0.1, periodic, shell_lead=1.0)
 
 
+def test_contacts_are_left_to_partners_with_earlier_events():
+    """A disk schedules its contact with j only if it comes no later than j's own next event
+    (j, predicted again at that event, finds the contact itself if it still comes): far fewer
+    of the events popped are stale (at φ = 0.5, 0.20 per collision without the rule, 0.08
+    with it), no contact is lost (``tests/test_reference.py``) and nothing overlaps."""
+    engine = gas(2000, 0.5, (True, True), seed=5)
+    engine.run(collisions=20_000)
+    stale, collisions = engine.counters[STALE_EVENTS], engine.collisions
+    engine.run(collisions=collisions + 40_000)
+    assert (engine.counters[STALE_EVENTS] - stale) / (engine.collisions - collisions) < 0.12
+    assert_no_overlap(engine)
+
+
 def test_rebased_clock_keeps_the_trajectory():
     """Restarting the clock every few events does not change the physics beyond round-off."""
     a = gas(300, 0.3, (True, True), seed=29)
@@ -344,6 +357,9 @@ def test_bad_input_is_rejected():
         Engine([[0.5, 0.5]], [[1.0, 0.0]], 0.1, restitution=1.5)
     with pytest.raises(ValueError, match="radius"):
         Engine([[0.5, 0.5]], [[1.0, 0.0]], -0.1)
+    with pytest.raises(ValueError, match=r"must exceed 2 \(R_1 \+ R_2\) = 1.02"):
+        Engine([[0.25, 0.25], [0.75, 0.75]], [[1.0, 0.0], [0.0, 1.0]], [0.26, 0.25],
+               boundary=Boundary(periodic=(True, True)))
 
 
 def test_neutral_effects_run_the_code_of_absent_ones():

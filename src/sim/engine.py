@@ -342,13 +342,18 @@ class Engine:
             raise ValueError(f"shell_lead must lie in [0, 1), got {lead}")
         delta_small = 0.5 * (ratio - 1.0) * 2.0 * median
         max_small = float(small_radius.max())
+        # the two largest radii: two disks whose shells overlap are less than R_i + R_j + 4 δ
+        # apart (shell centres within R_i + δ + R_j + δ, each disk within δ of its centre)
+        r_1, r_2 = (np.sort(radius)[-2:] if n > 1 else (0.0, radius[0]))
         for axis in range(2):
             if self.periodic[axis]:
-                # shells must not see two images of one disk: 2 (R + δ) ≤ L/2
-                limit = 0.25 * box[axis] - max_small
+                # predictions take the nearest image of a separation: that is the image in
+                # which the pair can touch only while R_1 + R_2 + 4 δ ≤ L/2
+                limit = 0.25 * (0.5 * box[axis] - r_1 - r_2)
                 if limit <= 0.0:
                     raise ValueError(f"periodic box side {box[axis]} is too small for disks of "
-                                     f"radius {max_small}: it must exceed 4 R")
+                                     f"radii {r_1:g} and {r_2:g}: it must exceed "
+                                     f"2 (R_1 + R_2) = {2.0 * (r_1 + r_2):g}")
                 delta_small = min(delta_small, limit)
         delta = np.full(n, delta_small)
         reach = max_small + delta_small

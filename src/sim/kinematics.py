@@ -40,7 +40,9 @@ def minimum_image(dx, length, periodic):
     """Nearest periodic image of a separation ``dx`` along an axis of ``length``.
 
     Requires ``|dx| < 1.5 length``: stored positions are wrapped into the box and a disk
-    never flies further than its shell (δ < L/4) before it is stored again.
+    never flies further than its shell (δ < L/8) before it is stored again. The engine sizes
+    shells so that two disks in each other's lists are less than L/2 apart in the image in
+    which they can touch (R_1 + R_2 + 4 δ ≤ L/2), which is then the nearest one.
     """
     if periodic:
         if dx > 0.5 * length:

@@ -8,7 +8,11 @@ counters when popped. Cost O(N) per event, memory growing with the heap. Each di
 its own clock and the contact roots use the same arithmetic as the engine, so the two agree
 to round-off for as long as chaos lets round-off stay small.
 
-Periodic axes are handled by testing the nine nearest images of each pair.
+Periodic axes are handled by testing the nine nearest images of each pair. That finds every
+contact as long as the pair moves less than a box side relative to each other between its
+last prediction and its contact, so on a periodic axis every disk is also re-predicted after
+flying half the shortest periodic side (a horizon event, applied silently): then the contact
+image is among the nine while the box side exceeds 2 (R_i + R_j).
 """
 
 import heapq
@@ -17,6 +21,7 @@ import math
 import numpy as np
 
 WALL = -1
+HORIZON = -10  # a re-prediction after half a periodic side of flight
 
 
 class ReferenceEngine:
@@ -46,6 +51,8 @@ class ReferenceEngine:
             shifts = [(-1, 0, 1) if p else (0,) for p in self.periodic]
             images = [(a * self.box[0], b * self.box[1]) for a in shifts[0] for b in shifts[1]]
         self.images = np.array(images)
+        periodic_sides = [side for side, p in zip(self.box, self.periodic, strict=True) if p]
+        self.horizon = 0.5 * min(periodic_sides) if periodic_sides else math.inf
         for i in range(n):
             self._predict(i)
 
@@ -55,7 +62,8 @@ class ReferenceEngine:
 
     def _predict(self, i):
         """Push every future contact of disk i (at the current time), with each other disk
-        (nearest image and, on periodic axes, its neighbours) and each wall."""
+        (nearest image and, on periodic axes, its neighbours) and each wall, and its horizon
+        event."""
         others = np.flatnonzero(np.arange(self.position.shape[0]) != i)
         dt = self.time - self.t_disk[others]
         r = self.position[i] - self.position[others] - self.velocity[others] * dt[:, None]
@@ -86,6 +94,9 @@ class ReferenceEngine:
             elif u > 0.0:
                 self._push(self.time + max((self.box[axis] - rad - x) / u, 0.0), i,
                            WALL - 2 * axis - 1, 0)
+        speed = math.hypot(*self.velocity[i])
+        if speed > 0.0 and math.isfinite(self.horizon):
+            self._push(self.time + self.horizon / speed, i, HORIZON, 0)
 
     def _advance(self, i, t):
         """Bring disk i to time t along its straight path (each disk keeps its own clock)."""
@@ -100,22 +111,29 @@ class ReferenceEngine:
         p = self.position + self.velocity * (t - self.t_disk)[:, None]
         return np.where(self.periodic, p % self.box, p)
 
-    def _discard_stale(self):
+    def _settle(self):
+        """Drop stale entries and apply due horizon events until a valid contact is on top."""
         while self.heap:
-            _, _, i, j, count_i, count_j = self.heap[0]
-            if count_i == self.count[i] and (j < 0 or count_j == self.count[j]):
+            t, _, i, j, count_i, count_j = self.heap[0]
+            if count_i != self.count[i] or (j >= 0 and count_j != self.count[j]):
+                heapq.heappop(self.heap)
+            elif j == HORIZON:
+                heapq.heappop(self.heap)
+                self.time = t
+                self._advance(i, t)
+                self._predict(i)
+            else:
                 return
-            heapq.heappop(self.heap)
 
     def next_event_time(self):
-        """Time of the next valid event (inf if none)."""
-        self._discard_stale()
+        """Time of the next valid contact (inf if none)."""
+        self._settle()
         return self.heap[0][0] if self.heap else math.inf
 
     def step(self):
-        """Apply the next valid event; returns (time, i, j) with j < 0 for walls
+        """Apply the next valid contact; returns (time, i, j) with j < 0 for walls
         (-1 left, -2 right, -3 bottom, -4 top)."""
-        self._discard_stale()
+        self._settle()
         t, _, i, j, _, _ = heapq.heappop(self.heap)
         self.time = t
         self._advance(i, t)
