@@ -344,7 +344,7 @@ class Engine:
         max_small = float(small_radius.max())
         # the two largest radii: two disks whose shells overlap are less than R_i + R_j + 4 δ
         # apart (shell centres within R_i + δ + R_j + δ, each disk within δ of its centre)
-        r_1, r_2 = (np.sort(radius)[-2:] if n > 1 else (0.0, radius[0]))
+        r_2, r_1 = (np.sort(radius)[-2:] if n > 1 else (0.0, radius[0]))
         for axis in range(2):
             if self.periodic[axis]:
                 # predictions take the nearest image of a separation: that is the image in

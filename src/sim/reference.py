@@ -107,7 +107,8 @@ class ReferenceEngine:
         self.t_disk[i] = t
 
     def positions(self, t):
-        """Positions of all disks at time t (not before the current time)."""
+        """Positions of all disks at time t, not before the last contact applied (horizon
+        events move a disk's clock but not its path)."""
         p = self.position + self.velocity * (t - self.t_disk)[:, None]
         return np.where(self.periodic, p % self.box, p)
 
