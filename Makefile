@@ -20,8 +20,8 @@ venv: $(STAMP)  ## make the virtual environment and install sim into it
 run: $(STAMP)  ## run the default scene
 	$(PY) -m sim
 
-test: $(STAMP)  ## quick tests (long physics runs are marked slow)
-	$(PY) -m pytest -q
+test: $(STAMP)  ## quick tests (long physics runs are marked slow), one worker per core
+	$(PY) -m pytest -q -n logical
 
 validate: $(STAMP)  ## every test, slow physics runs included; writes outputs/validation/table.md
 	$(PY) -m pytest -q -m ""

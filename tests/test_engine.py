@@ -2,6 +2,7 @@
 
 import math
 
+import numba
 import numpy as np
 import pytest
 
@@ -378,3 +379,13 @@ def test_neutral_effects_run_the_code_of_absent_ones():
     np.testing.assert_array_equal(neutral.positions(), absent.positions())
     polydisperse = gas(400, 0.4, seed=71, mass=np.linspace(1.0, 2.0, n))
     assert isinstance(polydisperse._per_disk_parameters()[1], np.ndarray)
+
+
+@pytest.mark.parametrize("species", [np.zeros(10, dtype=int), np.arange(10) % 2])
+def test_one_restitution_however_given_compiles_one_loop(species):
+    """ξ given as a number or as the matrix it stands for reaches the compiled loop as the
+    same numba type (a read-only view would be typed apart and compile the loop again)."""
+    s = int(species.max()) + 1
+    types = {numba.typeof(gas(10, 0.2, seed=3, species=species, restitution=xi).restitution)
+             for xi in (0.9, np.full((s, s), 0.9), [[0.9] * s] * s)}
+    assert len(types) == 1, types

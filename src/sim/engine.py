@@ -186,7 +186,9 @@ def _restitution_matrix(restitution, n_species):
         raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
     if np.all(xi == 1.0):
         return None
-    return np.ascontiguousarray(xi)
+    # always a fresh writable copy: numba types read-only arrays apart, so a view passed on
+    # for some inputs would compile the event loop a second time for the same effects
+    return np.array(xi)
 
 
 class Engine:
