@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from sim.kinematics import (
@@ -54,6 +54,7 @@ def test_pair_contact_time_is_never_negative_and_solves_contact(rx, ry, vx, vy, 
 
 @given(finite, finite, finite, finite, st.floats(0.01, 5.0),
        st.one_of(st.floats(0.0, 100.0), st.just(math.inf)))
+@example(1.0, 0.0, -2.092393952918845e-46, 0.0, 1.0, 2.2250738585e-313)  # -2bτ underflows
 def test_a_pair_the_filter_drops_touches_no_sooner(rx, ry, vx, vy, sigma, tau):
     """may_touch_before drops only pairs whose contact time is not below τ (to round-off),
     and with τ = ∞ it keeps every pair that ever touches."""
