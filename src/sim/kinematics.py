@@ -101,7 +101,7 @@ def may_touch_before(rx, ry, vx, vy, sigma, tau):
     With b = r·v and c = |r|² - σ² (as there), an approaching pair apart (b < 0 < c) has
     D = b² - a c ≤ b², hence τ_contact = c / (-b + sqrt(D)) ≥ c / (-2 b): it cannot touch
     before τ when c > -2 b τ. The test c ≤ -2 b τ is false as well for receding pairs apart
-    (b > 0 < c; also b = 0 with τ = ∞, where -2 b τ is NaN) and true for touching or
+    (b ≥ 0 < c; also b = 0 with τ = ∞, where -2 b τ is NaN) and true for touching or
     overlapping approaching ones, which collide at once, even when -2 b τ underflows to zero
     (a pair at contact approaching at 1e-46 with τ = 1e-313, found by hypothesis). The filter
     of Smallenburg's code (Eur. Phys. J. E 45, 22 (2022)): no square root or division for
