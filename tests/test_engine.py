@@ -386,6 +386,7 @@ def test_one_restitution_however_given_compiles_one_loop(species):
     """ξ given as a number or as the matrix it stands for reaches the compiled loop as the
     same numba type (a read-only view would be typed apart and compile the loop again)."""
     s = int(species.max()) + 1
+    # masses and t_c as in other tests, so that no variant of the loop is compiled for this one
     types = {numba.typeof(gas(10, 0.2, seed=3, species=species, mass=1.0 + species,
                               restitution=xi, tc=1e-6).restitution)
              for xi in (0.9, np.full((s, s), 0.9), [[0.9] * s] * s)}
