@@ -47,6 +47,8 @@ REORDER_MIN_DISKS = 20_000
 #: From this many disks on, the event loop prefetches several events ahead (``lookahead`` of
 #: :func:`sim.event_loop.run_events`). At φ = 0.5, against the same build without it: 0.94 at
 #: N = 2e4 and 3e4, whose state (290 bytes per disk) still sits mostly in cache, 1.11 at 5e4.
+#: The hints of a shell exit's cell scan start here too
+#: (:func:`sim.neighbours._prefetch_candidates`).
 LOOKAHEAD_MIN_DISKS = 40_000
 
 #: Entries every list gains when one list of a common capacity overflows (32 bytes): the

@@ -311,8 +311,9 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     contact (contacts made elastic by the TC model break the streak). A stall — more than
     16 N + 1000 events in a row at one instant — ends the loop instead of hanging it.
 
-    ``lookahead``: prefetch several events ahead, for states larger than the caches
-    (:func:`prefetch_upcoming`).
+    ``lookahead``: prefetch several events ahead, and the candidates of a shell exit's cell
+    scan, for states larger than the caches (:func:`prefetch_upcoming`,
+    :func:`sim.neighbours._prefetch_candidates`).
 
     Counters and accumulators live in local variables (registers) during the loop and are
     written back to ``counters`` and ``accumulators`` when it stops.
@@ -425,7 +426,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         elif partner == SHELL_EXIT:
             full = rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb,
                                       cell_head, cell_next, cell_prev, cell_of, big, geometry,
-                                      grid)
+                                      grid, lookahead)
             if full >= 0:
                 status = STATUS_LIST_FULL
                 culprit = full

@@ -182,8 +182,11 @@ def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, gr
     in cache), asks for all rows at once. Against the scan without it
     (``benchmarks/compare_builds.py``, on a day the machine waited 210–250 ns on memory beyond
     4 MiB): 1.18 at N = 1e5 and 1.16 at 1e6, φ = 0.5; 1.33 and 1.12 at 1e5, φ = 0.1 and 0.7;
-    1.10, 1.19 and 1.02 at 1e4, φ = 0.5, 0.1 and 0.7; 0.98 at 1e3 (quartiles 0.94–1.08),
-    whose state sits in cache.
+    1.10, 1.19 and 1.02 at 1e4, φ = 0.5, 0.1 and 0.7. On a day memory answered in 6 ns up to
+    0.5 MiB and 38 ns at 4 MiB, the scan without hints beat it while the state fits the
+    caches: 1.10, 1.03 and 1.02 at 1e4, φ = 0.1, 0.5 and 0.7; 1.13 and 1.06 at 1e3, φ = 0.1
+    and 0.5; 1.04 and 1.01 at 2e4; 1.00 and 0.99 at 3e4. Hence the hints only with the
+    look-ahead (:data:`sim.engine.LOOKAHEAD_MIN_DISKS`).
     """
     ncx = grid[0]
     ncy = grid[1]
@@ -199,7 +202,7 @@ def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, gr
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
                          nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
-                         grid):
+                         grid, hint_candidates):
     """Append after the list of disk i (its count unchanged) every disk j ≥ first_candidate,
     j ≠ i, whose shell overlaps the shell of i centred at (cx, cy) but not the one centred at
     (cx_old, cy_old); NaN for the old centre drops that condition.
@@ -208,6 +211,8 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     within its reach. Returns the number of disks found, or -1 when they do not fit the list.
     Every candidate is written into the next free slot and the number advances only on a hit:
     no branch on the test, whose outcome the branch predictor cannot guess.
+
+    ``hint_candidates``: hint the rows of all candidates first (:func:`_prefetch_candidates`).
 
     Compiled once and called, not inlined, by :func:`rebuild_neighbours` and
     :func:`build_all_neighbours` (both pass ``i`` and ``first_candidate`` as int64, so that
@@ -227,7 +232,8 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[3] != 0)
     free = list_start(nb_start, i) + nb_count[i]
     room = per_disk(nb_cap, i) - nb_count[i]
-    _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid)
+    if hint_candidates:
+        _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid)
     found = 0
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
@@ -305,7 +311,7 @@ def _full_list(first, found, nb_start, nb_cap, nb_count, nb):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_head, cell_next,
-                       cell_prev, cell_of, big, geometry, grid):
+                       cell_prev, cell_of, big, geometry, grid, hint_candidates):
     """New shell for disk i centred on its current position, and its new list.
 
     Only the differences are written. The lists hold exactly the pairs of overlapping shells,
@@ -316,13 +322,14 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
     First the new neighbours are found and every list they join is checked for room; only then
     are lists changed and the shell moved. On overflow (returned disk id ≥ 0) nothing has
     changed, and calling again after enlarging the lists does the rebuild.
+    ``hint_candidates``: see :func:`_find_new_neighbours`.
     """
     cx, cy = shell_centre(i, disks, delta, geometry, grid)
     start = list_start(nb_start, i)
     old = nb_count[i]
     found = _find_new_neighbours(np.int64(i), cx, cy, disks[i, CX], disks[i, CY], np.int64(0),
                                  disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
-                                 cell_next, cell_of, big, geometry, grid)
+                                 cell_next, cell_of, big, geometry, grid, hint_candidates)
     if found < 0:
         return i
     full = _full_list(start + old, found, nb_start, nb_cap, nb_count, nb)
@@ -373,7 +380,8 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
         first = list_start(nb_start, i) + nb_count[i]
         found = _find_new_neighbours(np.int64(i), disks[i, CX], disks[i, CY], np.nan, np.nan,
                                      np.int64(i + 1), disks, delta, nb_start, nb_cap, nb_count,
-                                     nb, cell_head, cell_next, cell_of, big, geometry, grid)
+                                     nb, cell_head, cell_next, cell_of, big, geometry, grid,
+                                     False)
         if found < 0:
             return i
         full = _full_list(first, found, nb_start, nb_cap, nb_count, nb)
