@@ -391,7 +391,8 @@ class Engine:
         while True:
             full = build_all_neighbours(d.table, shell_radius, d.is_big, *self._list_layout(),
                                         d.nb_count, d.nb, d.cell_head, d.cell_next,
-                                        d.cell_prev, d.cell_of, d.big, self.geometry, self.grid)
+                                        d.cell_prev, d.cell_of, d.big, self.geometry, self.grid,
+                                        self.lookahead)
             if full < 0:
                 break
             self._grow_lists(full)

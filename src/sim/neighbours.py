@@ -362,9 +362,11 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, cell_head,
-                         cell_next, cell_prev, cell_of, big, geometry, grid):
+                         cell_next, cell_prev, cell_of, big, geometry, grid, hint_candidates):
     """Centre every shell on its disk, file the small disks in cells and link all pairs.
-    Returns the disk whose list overflowed, or -1."""
+    Returns the disk whose list overflowed, or -1. ``hint_candidates``: see
+    :func:`_find_new_neighbours` (a bool passed from Python, as the event loop's, so that
+    both callers share one specialisation)."""
     n = disks.shape[0]
     cell_head[:] = -1
     nb_count[:] = 0
@@ -381,7 +383,7 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
         found = _find_new_neighbours(np.int64(i), disks[i, CX], disks[i, CY], np.nan, np.nan,
                                      np.int64(i + 1), disks, delta, nb_start, nb_cap, nb_count,
                                      nb, cell_head, cell_next, cell_of, big, geometry, grid,
-                                     False)
+                                     hint_candidates)
         if found < 0:
             return i
         full = _full_list(first, found, nb_start, nb_cap, nb_count, nb)
