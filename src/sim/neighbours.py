@@ -215,8 +215,9 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     ``hint_candidates``: hint the rows of all candidates first (:func:`_prefetch_candidates`).
 
     Compiled once and called, not inlined, by :func:`rebuild_neighbours` and
-    :func:`build_all_neighbours` (both pass ``i`` and ``first_candidate`` as int64, so that
-    they share one specialisation): 3.5 s less of the first compilation.
+    :func:`build_all_neighbours` (both pass ``i`` and ``first_candidate`` as int64 and
+    ``hint_candidates`` as a bool from Python, never a literal, so that they share one
+    specialisation): 3.5 s less of the first compilation, and 2.8 s more for a literal.
     """
     ncx = grid[0]
     ncy = grid[1]
@@ -365,8 +366,7 @@ def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, c
                          cell_next, cell_prev, cell_of, big, geometry, grid, hint_candidates):
     """Centre every shell on its disk, file the small disks in cells and link all pairs.
     Returns the disk whose list overflowed, or -1. ``hint_candidates``: see
-    :func:`_find_new_neighbours` (a bool passed from Python, as the event loop's, so that
-    both callers share one specialisation)."""
+    :func:`_find_new_neighbours`."""
     n = disks.shape[0]
     cell_head[:] = -1
     nb_count[:] = 0
