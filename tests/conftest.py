@@ -5,11 +5,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from sim.audit import outside_box, overlapping_pairs
 from sim.engine import Boundary, Engine
 from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
 from sim.validation import table
+
+#: Tests never depend on the clock: no example has a deadline (the first example of a test
+#: compiles numba code, and a loaded machine runs anything slowly).
+settings.register_profile("sim", deadline=None)
+settings.load_profile("sim")
 
 
 def gas(n, phi, periodic=(False, False), seed=0, speed=1.0, **engine_options):

@@ -44,9 +44,10 @@ def uninterrupted(tmp_path_factory):
 
 def run_until_killed(folder, after_seconds, how):
     process = cli(*LONG_RUN, f"hydra.run.dir={folder}", cwd=folder)
-    deadline = time.monotonic() + 120
-    while not (folder / "run.h5").exists() and time.monotonic() < deadline:
-        time.sleep(0.05)  # compiling; the clock starts with the run file
+    for _ in range(12000):  # compiling; the clock starts with the run file
+        if (folder / "run.h5").exists() or process.poll() is not None:
+            break
+        time.sleep(0.05)
     time.sleep(after_seconds)
     process.send_signal(how)
     out, err = process.communicate(timeout=300)
@@ -107,7 +108,7 @@ def test_a_disk_that_fills_up_stops_the_run_before_a_write_and_keeps_the_file(
 
     def filling_up(folder):
         calls["n"] += 1
-        return 10**12 if calls["n"] <= 2 else sim.h5md.DISK_MARGIN_BYTES // 2
+        return 10**12 if calls["n"] <= 3 else sim.h5md.DISK_MARGIN_BYTES // 2
 
     monkeypatch.setattr(sim.h5md, "free_bytes", filling_up)
     cfg = compose_config(["disks.n=500", "stop.collisions=200000",
@@ -123,27 +124,54 @@ def test_a_disk_that_fills_up_stops_the_run_before_a_write_and_keeps_the_file(
 
 
 def test_a_write_the_system_refuses_ends_with_one_line(tmp_path):
-    """A file-size limit makes the operating system refuse a write mid-run (as a full disk
-    does when the free-space check cannot see it coming): exit status 1, one line."""
+    """A file-size limit (``ulimit -f``) is checked before every write as the disk's free
+    room is: the run stops before the write that would cross it, exit status 1, one line,
+    and the file stays readable."""
     def limited():
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-        resource.setrlimit(resource.RLIMIT_FSIZE, (1 << 20, 1 << 20))
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4 << 20, 4 << 20))
 
     process = cli("disks.n=2000", "output.every_collisions=1000", f"hydra.run.dir={tmp_path}",
                   cwd=tmp_path, preexec_fn=limited)
     _, err = process.communicate(timeout=300)
     assert process.returncode == 1
     lines = [line for line in err.splitlines() if line.strip()]
-    assert len(lines) == 1 and lines[0].startswith("sim: writing the run file")
+    assert len(lines) == 1 and lines[0].startswith("sim: stopped before writing to")
+    assert "ulimit -f" in lines[0]
+    info = summary(tmp_path / "run.h5")  # readable, with what its last flush wrote
+    assert info["stop_reason"].startswith("error: file size limit") and info["snapshots"] >= 1
+
+
+#: the command line with a file-size limit that the writer's check cannot see: the operating
+#: system refuses a write half-way, as a disk that fills up faster than checked would
+UNFORESEEN_LIMIT = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (4 << 20, 4 << 20))
+import sim.h5md
+sim.h5md.size_limit = lambda: float("inf")
+from sim.cli import main
+sys.argv = ["sim", *sys.argv[1:]]
+main()
+"""
+
+
+def test_a_write_the_system_refuses_unforeseen_ends_with_one_line(tmp_path):
+    process = subprocess.run([sys.executable, "-c", UNFORESEEN_LIMIT, "disks.n=2000",
+                              "output.every_collisions=1000", "output.progress=false",
+                              f"hydra.run.dir={tmp_path}"], cwd=tmp_path, capture_output=True,
+                             text=True, timeout=300)
+    lines = [line for line in process.stderr.splitlines() if line.strip()]
+    assert process.returncode == 1
+    assert len(lines) == 1 and lines[0].startswith("sim: writing the run file"), lines
 
 
 def test_a_folder_that_cannot_be_written_is_a_clear_error(tmp_path):
-    cfg = compose_config(["disks.n=100", "output.file=/proc/run.h5", "output.progress=false"])
-    with pytest.raises(runner.RunFileError, match="cannot write the run file /proc/run.h5"):
-        runner.run(cfg, tmp_path)
-    process = cli("disks.n=100", "output.file=/proc/run.h5", f"hydra.run.dir={tmp_path}",
-                  cwd=tmp_path)
+    cfg = compose_config(["disks.n=100", "output.progress=false"])
+    with pytest.raises(runner.RunFileError, match="cannot write the run file /proc/x/run.h5"):
+        runner.run(cfg, "/proc/x")
+    process = cli("disks.n=100", "hydra.run.dir=/proc/x", cwd=tmp_path)
     _, err = process.communicate(timeout=300)
     assert process.returncode == 1
-    assert [line for line in err.splitlines() if line.strip()][0].startswith(
-        "sim: cannot write the run file")
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("sim: cannot write in the run folder /proc/x")

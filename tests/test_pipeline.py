@@ -3,6 +3,7 @@ values exit with status 2 and write nothing, resume continues to the same bits, 
 
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import h5py
@@ -12,8 +13,8 @@ import yaml
 from hydra import compose, initialize_config_dir
 
 from sim import runner
-from sim.__main__ import CONF_DIR
 from sim.analysis import open_run, open_sweep
+from sim.cli import CONF_DIR
 from sim.config import ConfigError, register
 from sim.inspect import RunFileError, summary
 
@@ -228,7 +229,7 @@ def test_a_failing_job_is_reported_and_the_others_finish(tmp_path, monkeypatch):
 
     original = sim.scenes.BUILDERS["crater"]
     monkeypatch.setitem(sim.scenes.BUILDERS, "crater", crater_that_fails_for_big_projectiles)
-    from sim import __main__ as entry
+    from sim import cli as entry
 
     monkeypatch.setattr(sys, "argv", [
         "sim", "scenario=crater", "projectile.radius=0.01,0.02", "bed.n=300",
@@ -244,15 +245,21 @@ def test_a_failing_job_is_reported_and_the_others_finish(tmp_path, monkeypatch):
     assert (tmp_path / "0" / "run.h5").exists()
 
 
-@pytest.mark.parametrize("seconds", [5.0, 7.5])
+@pytest.mark.parametrize("seconds", [0.0, 2.5])
 def test_a_killed_run_leaves_a_readable_file(seconds, tmp_path):
+    """SIGKILL ``seconds`` after the run file appeared (it appears whole: header, first
+    snapshot and checkpoint): the file opens, with every frame flushed before the kill."""
     run = subprocess.Popen([sys.executable, "-m", "sim", "disks.n=3000",
                             "stop.collisions=100000000", "output.every_collisions=3000",
                             f"hydra.run.dir={tmp_path}"], cwd=tmp_path,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        run.wait(timeout=seconds)
-    except subprocess.TimeoutExpired:
+        for _ in range(6000):  # compiling on a cold cache takes a while; a loaded machine more
+            if (tmp_path / "run.h5").exists() or run.poll() is not None:
+                break
+            time.sleep(0.1)
+        time.sleep(seconds)
+    finally:
         run.kill()  # SIGKILL: no clean-up code runs
         run.wait()
     info = summary(tmp_path / "run.h5")
@@ -321,7 +328,7 @@ def test_a_sweep_runs_through_submitit(tmp_path):
 def test_the_cluster_launcher_config_composes_to_slurm():
     from hydra import compose, initialize_config_dir
 
-    from sim.__main__ import CONF_DIR
+    from sim.cli import CONF_DIR
 
     with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
         cfg = compose("config", overrides=["hydra/launcher=cluster"], return_hydra_config=True)

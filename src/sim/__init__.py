@@ -1,14 +1,21 @@
 """sim: event-driven simulation of hard disks in two dimensions."""
 
-import hashlib
 import os
-from importlib.metadata import PackageNotFoundError, version
-from pathlib import Path
+import zlib
 
-try:
-    __version__ = version("sim")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
+
+def __getattr__(name):
+    """``sim.__version__``, looked up when first asked for: importing ``sim`` stays quick
+    (``os`` and ``zlib`` only), so that the command line takes Ctrl-C almost from its first
+    moment."""
+    if name != "__version__":
+        raise AttributeError(f"module 'sim' has no attribute {name!r}")
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("sim")
+    except PackageNotFoundError:  # running from a source tree that is not installed
+        return "0+unknown"
 
 
 def _numba_cache_dir():
@@ -17,16 +24,19 @@ def _numba_cache_dir():
     numba checks only the timestamp of the file that defines a cached function, not of the
     files whose functions it inlined, so an edit to ``kinematics.py`` would leave a stale
     ``run_events`` in the cache. Keying the cache folder by a hash of every module with
-    compiled code avoids it.
+    compiled code avoids it. The key is a CRC-32 and an Adler-32 of those sources (zlib
+    loads in a fraction of a millisecond, hashlib's OpenSSL in about 20).
     """
-    digest = hashlib.sha1()
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        source = path.read_bytes()
+    crc, adler = 0, 1
+    here = os.path.dirname(os.path.abspath(__file__))
+    for name in sorted(n for n in os.listdir(here) if n.endswith(".py")):
+        with open(os.path.join(here, name), "rb") as module:
+            source = module.read()
         if b"@njit" in source:
-            digest.update(path.name.encode())
-            digest.update(source)
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return str(base / "sim" / "numba" / digest.hexdigest()[:16])
+            for part in (name.encode(), source):
+                crc, adler = zlib.crc32(part, crc), zlib.adler32(part, adler)
+    base = os.environ.get("XDG_CACHE_HOME", os.path.join(os.path.expanduser("~"), ".cache"))
+    return os.path.join(base, "sim", "numba", f"{crc:08x}{adler:08x}")
 
 
 if "NUMBA_CACHE_DIR" not in os.environ:

@@ -17,6 +17,7 @@ snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate; e
 resolved config (YAML) and stop reason are the variables ``config`` and ``stop_reason``.
 """
 
+import warnings
 from pathlib import Path
 
 import h5py
@@ -27,14 +28,27 @@ from xarray.backends import BackendArray
 from xarray.core import indexing
 
 from sim.h5md import OBSERVABLES
-from sim.inspect import DAMAGE, RunFileError, open_run_file
+from sim.inspect import (
+    DAMAGE,
+    RunFileError,
+    damage_reason,
+    describe,
+    open_run_file,
+    read_intact,
+    series_damage,
+    snapshot_column,
+)
 
 
 class _H5Array(BackendArray):
-    """An h5py dataset as a lazily indexed xarray backend array."""
+    """A time series' h5py dataset (``position``, ``velocity``) as a lazily indexed xarray
+    backend array: a read that meets damaged frames reads frame by frame, gives NaN for the
+    damaged ones and says which in one RuntimeWarning."""
 
-    def __init__(self, dataset):
+    def __init__(self, dataset, times, path):
         self.dataset = dataset
+        self.times = times
+        self.path = path
         self.shape = dataset.shape
         self.dtype = dataset.dtype
 
@@ -43,26 +57,57 @@ class _H5Array(BackendArray):
                                                   self._read)
 
     def _read(self, key):
-        return self.dataset[key]
+        try:
+            return self.dataset[key]
+        except OSError:  # a frame fails its checksum
+            pass
+        out = np.full(np.broadcast_to(np.empty((), self.dtype), self.shape)[key].shape, np.nan)
+        frames = range(self.shape[0])[key[0]]
+        single = isinstance(frames, int)
+        damaged = []
+        for k, i in enumerate([frames] if single else frames):
+            try:
+                frame = self.dataset[(i, *key[1:])]
+            except OSError:
+                damaged.append(i)
+                continue
+            out[() if single else k] = frame
+        if damaged:
+            warnings.warn(f"{self.path}: "
+                          f"{describe(series_damage(self.dataset, damaged, self.times))}; read "
+                          f"as NaN", RuntimeWarning, stacklevel=2)
+        return out
 
 
-def _lazy(dataset, dims):
-    return xr.Variable(dims, indexing.LazilyIndexedArray(_H5Array(dataset)))
+def _needed(path, dataset):
+    """``dataset``, which the run cannot be read without, or :class:`RunFileError`."""
+    try:
+        return dataset[()]
+    except OSError as error:
+        raise RunFileError(f"{path}: {dataset.name.lstrip('/')} is damaged "
+                           f"({damage_reason(dataset)}); the run file cannot be read without "
+                           f"it") from error
 
 
 def open_run(path):
     """The run file at ``path`` as an :class:`xarray.Dataset` (see the module docstring).
-    Close it with ``ds.close()`` (or use it in a ``with`` block) to release the file."""
+    Close it with ``ds.close()`` (or use it in a ``with`` block) to release the file.
+
+    Damaged snapshots are NaN: those of the observables, checked at opening, are listed in
+    ``ds.attrs["damaged"]`` and one RuntimeWarning; those of ``position`` and ``velocity``
+    in a RuntimeWarning of the read that meets them. A damaged dataset that the run cannot be
+    read without (``radius``, ``mass``, ``species``, box edges, an observer's coordinates)
+    or ``/parameters`` is :class:`RunFileError`."""
     f = open_run_file(path)
     try:
         disks = f["particles/disks"]
-        time = disks["position/time"][()]
+        time = snapshot_column(f, "time")
+        step = snapshot_column(f, "step")
         n_species = f["observables/kinetic_energy_by_species/value"].shape[1]
-        data = {
-            "position": _lazy(disks["position/value"], ("time", "disk", "axis")),
-            "velocity": _lazy(disks["velocity/value"], ("time", "disk", "axis")),
-        }
-        axes = {}
+        data = {name: xr.Variable(("time", "disk", "axis"), indexing.LazilyIndexedArray(
+                    _H5Array(disks[f"{name}/value"], time, path)))
+                for name in ("position", "velocity")}
+        axes, damaged = {}, []
         for name, group in f["observables"].items():
             if name.endswith("by_species"):
                 dims = ("time", "species")
@@ -70,58 +115,91 @@ def open_run(path):
                 dims = ("time",)
             else:  # an observer's: its dims as an attribute, coordinates beside its value
                 dims = ("time", *(str(d) for d in group.attrs["dims"]))
-                axes.update({k: group[k][()] for k in group
+                axes.update({k: _needed(path, group[k]) for k in group
                              if k not in ("step", "time", "value")})
-            data[name] = xr.Variable(dims, group["value"][()],
+            values, frames = read_intact(group["value"])
+            if frames:
+                damaged.append(describe(series_damage(group["value"], frames, time)))
+            data[name] = xr.Variable(dims, values,
                                      attrs={"unit": group["value"].attrs.get("unit", ""),
                                             "description": group.attrs.get("description", "")})
-        parameters = f["parameters"].attrs
-        config = yaml.safe_load(parameters["config"])
+        try:
+            parameters = f["parameters"].attrs
+            config = yaml.safe_load(parameters["config"])
+            attrs = {"scene": config.get("scene", ""), "seed": int(parameters["seed"]),
+                     "config": str(parameters["config"]),
+                     "stop_reason": str(parameters["stop_reason"])}
+        except (*DAMAGE, yaml.YAMLError, AttributeError) as error:
+            raise RunFileError(f"{path}: /parameters is damaged ({' '.join(str(error).split())})"
+                               f"; the run file cannot be read without it") from error
         box = disks["box"]
         ds = xr.Dataset(
             data,
-            coords={"time": time, "step": ("time", disks["position/step"][()]),
+            coords={"time": time,
+                    "step": ("time", step if np.isnan(step).any() else step.astype(np.int64)),
                     "axis": ["x", "y"], "species": np.arange(n_species),
-                    "radius": ("disk", disks["radius"][()]), "mass": ("disk", disks["mass"][()]),
-                    "species_id": ("disk", disks["species"][()]), **axes},
-            attrs={"scene": config.get("scene", ""), "seed": int(parameters["seed"]),
-                   "config": str(parameters["config"]),
-                   "stop_reason": str(parameters["stop_reason"]),
-                   "box": box["edges"][()].tolist(),
+                    "radius": ("disk", _needed(path, disks["radius"])),
+                    "mass": ("disk", _needed(path, disks["mass"])),
+                    "species_id": ("disk", _needed(path, disks["species"])), **axes},
+            attrs={**attrs, "box": _needed(path, box["edges"]).tolist(),
                    "boundary": [b.decode() for b in box.attrs["boundary"]],
-                   "path": str(path)})
+                   "path": str(path), "damaged": damaged})
+    except RunFileError:
+        f.close()
+        raise
     except DAMAGE as error:
         f.close()
         raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
     except Exception:
         f.close()
         raise
+    if damaged:
+        warnings.warn(f"{path}: damaged, read as NaN: {'; '.join(damaged)}", RuntimeWarning,
+                      stacklevel=2)
     ds.set_close(f.close)
     return ds
 
 
-def _overrides(job_dir):
-    path = Path(job_dir, ".hydra", "overrides.yaml")
-    items = yaml.safe_load(path.read_text()) if path.exists() else []
-    return dict(item.split("=", 1) for item in items if "=" in item and
-                not item.startswith("hydra"))
+def _labels(path):
+    """{key: value} of the overrides a run file records (``/parameters`` attribute
+    ``overrides``), each value the one its resolved config holds under that key (the text
+    of the override for keys outside the config, such as ``scenario``)."""
+    with open_run_file(path) as f:
+        attrs = f["parameters"].attrs
+        overrides = yaml.safe_load(str(attrs.get("overrides", "[]"))) or []
+        config = yaml.safe_load(str(attrs["config"]))
+    labels = {}
+    for item in overrides:
+        key, _, text = item.partition("=")
+        key = key.lstrip("+~")
+        if key.startswith("hydra"):
+            continue
+        node = config
+        for part in key.split("."):
+            node = node.get(part, _MISSING) if isinstance(node, dict) else _MISSING
+        labels[key] = _parsed(text) if node is _MISSING else node
+    return labels
 
 
-def _value(text):
+def _parsed(text):
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError:
         return text
 
 
+_MISSING = object()
+
+
 def open_sweep(multirun_dir):
-    """The runs of a sweep directory in one Dataset, one dimension per swept parameter."""
+    """The runs of a sweep directory in one Dataset, one dimension per swept parameter: the
+    overrides that differ between runs, labelled with what each run file records."""
     runs = sorted(Path(multirun_dir).glob("*/run.h5"))
     if not runs:
         raise FileNotFoundError(f"no */run.h5 under {multirun_dir}")
-    overrides = [_overrides(run.parent) for run in runs]
+    overrides = [_labels(run) for run in runs]
     keys = sorted({k for o in overrides for k in o})
-    swept = [k for k in keys if len({o.get(k) for o in overrides}) > 1]
+    swept = [k for k in keys if len({repr(o.get(k)) for o in overrides}) > 1]
     datasets, configs, reasons = [], [], []
     for run, override in zip(runs, overrides, strict=True):
         ds = open_run(run).load()
@@ -130,7 +208,7 @@ def open_sweep(multirun_dir):
             snapshot=np.arange(ds.sizes["time"]), time=("snapshot", ds["time"].values))
         configs.append(ds.attrs.pop("config"))
         reasons.append(ds.attrs.pop("stop_reason"))
-        datasets.append(ds.expand_dims({k.replace(".", "_"): [_value(override[k])]
+        datasets.append(ds.expand_dims({k.replace(".", "_"): [override[k]]
                                         for k in swept}))
     if not swept:
         combined = xr.concat(datasets, dim="run", join="outer", data_vars="all",
@@ -145,7 +223,7 @@ def open_sweep(multirun_dir):
         per_run = xr.DataArray(np.empty([combined.sizes[d] for d in dims], dtype=object),
                                dims=dims, coords={d: combined[d] for d in dims})
         for override, text in zip(overrides, texts, strict=True):
-            per_run.loc[{k.replace(".", "_"): _value(override[k]) for k in swept}] = text
+            per_run.loc[{k.replace(".", "_"): override[k] for k in swept}] = text
         combined[name] = per_run
     for name in (k.replace(".", "_") for k in swept):
         combined = combined.sortby(name)

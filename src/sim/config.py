@@ -8,16 +8,38 @@ on every key; ``conf/scenario/*.yaml`` are the scenes.
 """
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any, Optional
 
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
+from sim.engine import RESOLUTION_LIMIT, SCALE_LIMIT
 from sim.initial import RSA_JAMMING
 
 SCENES = ("single_disk", "two_disks", "scattering", "gas", "mixture", "crater", "cooling",
           "driven", "vibrated_bed")
+
+#: Scenes with a fixed number of disks, which ``disks.n`` must not contradict.
+FIXED_COUNT = {"single_disk": 1, "two_disks": 2, "scattering": 2}
+
+#: Every dimensional number of a scene (a length, speed, mass, time, temperature or
+#: acceleration) is 0 or of a magnitude in [SMALLEST, LARGEST], the engine's own range
+#: (:data:`sim.engine.SCALE_LIMIT`): squares and products stay inside float64's.
+SMALLEST, LARGEST = 1.0 / SCALE_LIMIT, SCALE_LIMIT
+
+#: Smallest disk radius, as a fraction of the box's longer side (the engine's
+#: :data:`sim.engine.RESOLUTION_LIMIT`, against the far edge of the disks, which the box
+#: side bounds): float64 positions resolve 2⁻⁵² of the side, and smaller disks' contacts
+#: drown in round-off.
+SMALLEST_RADIUS = RESOLUTION_LIMIT
+
+#: Largest seed: the compiled generator of thermal walls keys its draws with an int64.
+MAX_SEED = 2**63 - 1
+#: Largest number of disks: the engine numbers them with int32.
+MAX_DISKS = 2**31 - 1
+#: Largest collision or contact count: int64 counters, with room to add a chunk.
+MAX_COUNT = 2**62
 
 
 class ConfigError(ValueError):
@@ -184,6 +206,62 @@ def register():
     ConfigStore.instance().store(name="sim_schema", node=SimConfig)
 
 
+def integer_keys(node=SimConfig, prefix=""):
+    """Dotted keys of the schema typed int (``disks.n``, ``stop.collisions``, …)."""
+    keys = []
+    for f in fields(node):
+        kind = f.type
+        inner = [a for a in getattr(kind, "__args__", ()) if a is not type(None)]
+        if kind is int or inner == [int]:
+            keys.append(prefix + f.name)
+        elif is_dataclass(kind) or (inner and is_dataclass(inner[0])):
+            keys += integer_keys(kind if is_dataclass(kind) else inner[0], f"{prefix}{f.name}.")
+    return keys
+
+
+def _numbers(value):
+    if isinstance(value, (list, tuple)):
+        for item in value:
+            yield from _numbers(item)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield value
+
+
+def _check_numbers(c):
+    """Every number of the config finite, and every dimensional one 0 or within
+    [SMALLEST, LARGEST]; seeds and counts have their own ranges."""
+    counts = set(integer_keys())
+
+    def walk(node, prefix):
+        for key, value in node.items():
+            if isinstance(value, dict):
+                yield from walk(value, f"{prefix}{key}.")
+            else:
+                yield f"{prefix}{key}", value
+
+    for key, value in walk(OmegaConf.to_container(c), ""):
+        if key in counts or key == "resume":
+            continue
+        for x in _numbers(value):
+            if not math.isfinite(x):
+                raise ConfigError(key, value, "finite numbers")
+            if x != 0 and not SMALLEST <= abs(x) <= LARGEST:
+                raise ConfigError(key, value, f"0 or a magnitude between {SMALLEST:g} and "
+                                  f"{LARGEST:g}")
+    if not 0 <= c.seed <= MAX_SEED:
+        raise ConfigError("seed", c.seed, f"an integer from 0 to 2^63 − 1 = {MAX_SEED}")
+
+
+def _resolvable(c, key, radius, value=None):
+    """Refuse a disk radius that float64 positions in this box cannot resolve."""
+    side = max(float(x) for x in c.box.size)
+    if radius is not None and radius < SMALLEST_RADIUS * side:
+        raise ConfigError(key, radius if value is None else value,
+                          f"disks of radius at least 2^-40 of the box's longer "
+                          f"side ({SMALLEST_RADIUS * side:.3g} here; this gives "
+                          f"{radius:.3g}): float64 positions resolve 2^-52 of the side")
+
+
 def _positive(cfg, key, value, allow_none=True, zero=False):
     if value is None:
         if allow_none:
@@ -229,9 +307,10 @@ def _validate_bed(c):
     if b is None:
         raise ConfigError("scene", c.scene, f"the {c.scene} scene needs a bed")
     _positive(c, "bed.radius", b.radius, allow_none=False)
+    _resolvable(c, "bed.radius", b.radius)
     _positive(c, "bed.mass", b.mass, allow_none=False)
-    if b.n < 1:
-        raise ConfigError("bed.n", b.n, "at least 1 disk")
+    if not 1 <= b.n < MAX_DISKS:
+        raise ConfigError("bed.n", b.n, f"from 1 to {MAX_DISKS - 1} disks")
     lx, ly = c.box.size
     _within("bed.height", b.height, 1e-12, ly, f"between 0 and the box height {ly}")
     bed_phi = b.n * math.pi * b.radius**2 / (lx * b.height)
@@ -246,19 +325,28 @@ def validate(cfg: Any) -> None:
     c = cfg if isinstance(cfg, DictConfig) else OmegaConf.structured(cfg)
     if c.scene not in SCENES:
         raise ConfigError("scene", c.scene, f"one of {', '.join(SCENES)}")
+    _check_numbers(c)
     if len(c.box.size) != 2 or any(not (s > 0) for s in c.box.size):
         raise ConfigError("box.size", list(c.box.size), "two positive side lengths [Lx, Ly]")
     if c.box.boundary not in ("walls", "periodic"):
         raise ConfigError("box.boundary", c.box.boundary, "walls or periodic")
     d = c.disks
-    if d.n < 1:
-        raise ConfigError("disks.n", d.n, "at least 1 disk")
+    if not 1 <= d.n <= MAX_DISKS:
+        raise ConfigError("disks.n", d.n, f"from 1 to {MAX_DISKS} disks")
+    if c.scene in FIXED_COUNT and d.n != FIXED_COUNT[c.scene]:
+        raise ConfigError("disks.n", d.n, f"{FIXED_COUNT[c.scene]}: the {c.scene} scene has "
+                          f"exactly that many disks")
     if d.radius is not None and d.packing_fraction is not None:
         raise ConfigError("disks.radius", d.radius,
                           "give disks.radius or disks.packing_fraction, not both")
     _positive(c, "disks.radius", d.radius)
+    _resolvable(c, "disks.radius", d.radius)
     _within("disks.packing_fraction", d.packing_fraction, 1e-12, 0.9,
             "between 0 and 0.9 (hexagonal close packing is 0.9069)")
+    if d.radius is None and d.packing_fraction is not None and c.scene not in FIXED_COUNT:
+        area = float(c.box.size[0]) * float(c.box.size[1])
+        _resolvable(c, "disks.packing_fraction",
+                    math.sqrt(d.packing_fraction * area / (d.n * math.pi)), d.packing_fraction)
     _positive(c, "disks.mass", d.mass, allow_none=False)
     if d.speed is not None and d.temperature is not None:
         raise ConfigError("disks.speed", d.speed,
@@ -282,6 +370,9 @@ def validate(cfg: Any) -> None:
     s = c.stop
     for key in ("collisions", "events", "time", "wall_seconds"):
         _positive(c, f"stop.{key}", s[key])
+    for key in ("collisions", "events"):
+        if s[key] is not None and s[key] > MAX_COUNT:
+            raise ConfigError(f"stop.{key}", s[key], f"at most 2^62 = {MAX_COUNT}")
     _within("stop.energy_fraction", s.energy_fraction, 0.0, 1.0, "between 0 and 1")
     if s.at_rest is not None and not 0.0 < s.at_rest <= 1.0:
         raise ConfigError("stop.at_rest", s.at_rest, "a fraction in (0, 1]")
@@ -290,10 +381,16 @@ def validate(cfg: Any) -> None:
         raise ConfigError("stop", None, "at least one of stop.collisions, stop.events, "
                           "stop.time, stop.energy_fraction, stop.at_rest, stop.wall_seconds")
     o = c.output
+    if not o.file or "/" in o.file or o.file.startswith(".") or not o.file.strip():
+        raise ConfigError("output.file", o.file, "a file name in the run folder, such as "
+                          "run.h5 (no folders; not starting with a dot)")
     if o.every_collisions is not None and o.every_time is not None:
         raise ConfigError("output.every_collisions", o.every_collisions,
                           "give output.every_collisions or output.every_time, not both")
     _positive(c, "output.every_collisions", o.every_collisions)
+    if o.every_collisions is not None and o.every_collisions > MAX_COUNT:
+        raise ConfigError("output.every_collisions", o.every_collisions,
+                          f"at most 2^62 = {MAX_COUNT}")
     _positive(c, "output.every_time", o.every_time)
     rdf = c.observe.radial_distribution
     if rdf.bins is not None:
@@ -317,6 +414,7 @@ def validate(cfg: Any) -> None:
         if p is None:
             raise ConfigError("scene", c.scene, "the crater scene needs projectile and bed")
         _positive(c, "projectile.radius", p.radius, allow_none=False)
+        _resolvable(c, "projectile.radius", p.radius)
         _positive(c, "projectile.speed", p.speed, zero=True, allow_none=False)
         _positive(c, "projectile.mass", p.mass)
         lx, ly = c.box.size
@@ -335,12 +433,18 @@ def validate(cfg: Any) -> None:
                               "one mass per entry of mixture.fractions")
         if any(not (x > 0) for x in m.masses):
             raise ConfigError("mixture.masses", list(m.masses), "positive masses")
-        if any(x < 0 for x in m.fractions) or abs(sum(m.fractions) - 1.0) > 1e-9:
+        if any(not (x > 0) for x in m.fractions) or abs(sum(m.fractions) - 1.0) > 1e-9:
             raise ConfigError("mixture.fractions", list(m.fractions),
-                              "non-negative fractions that sum to 1")
+                              "positive fractions that sum to 1")
+        counts = [math.floor(x * d.n) for x in m.fractions]
+        if min(counts[1:], default=1) < 1:
+            raise ConfigError("mixture.fractions", list(m.fractions),
+                              f"fractions that give every species at least one of the "
+                              f"disks.n={d.n} disks (a species gets floor(fraction × n))")
     if c.scene == "scattering":
         sc = c.scattering
         _positive(c, "scattering.target_radius", sc.target_radius, allow_none=False)
+        _resolvable(c, "scattering.target_radius", sc.target_radius)
         _positive(c, "scattering.target_mass", sc.target_mass, allow_none=False)
         if d.radius is None:
             raise ConfigError("disks.radius", None, "the scattering projectile needs a radius")

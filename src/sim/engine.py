@@ -12,20 +12,22 @@ in the original order.
 """
 
 import math
+import operator
 import time as wallclock
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from sim import event_loop as loop
-from sim.event_queue import build_queue, empty_queue
+from sim.event_queue import BLOCK_EVENTS, build_queue, empty_queue
 from sim.gravity import gravity_vector, potential_energy
-from sim.kinematics import DISK_COLUMNS, RADIUS, T_OWN, VX, VY, X, Y
+from sim.kinematics import DISK_COLUMNS, RADIUS, T_OWN, VX, VY, X, Y, minimum_image
 from sim.neighbours import build_all_neighbours, grow_lists, list_starts
 from sim.parameters import common_value
 from sim.recorders import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
 from sim.state import DiskArrays
-from sim.walls import wall_motion, wall_state, wall_temperature
+from sim.walls import NAMES, wall_motion, wall_state, wall_temperature
 
 #: Neighbour-shell diameter r_n/σ by packing fraction (Smallenburg 2022 found 2.0 best at
 #: φ = 0.5 and about 4.6 at φ = 0.1); interpolated linearly between the points.
@@ -63,16 +65,28 @@ BIG_RADIUS_RATIO = 2.0
 MAX_BIG = 64
 
 
-class StalledError(RuntimeError):
+class PhysicsBreakdown(RuntimeError):
+    """The run cannot go on: the dynamics left what the engine can follow. Each kind names
+    its cause in the class attribute ``stop_reason`` (recorded in the run file), and its
+    message, one line, says what to change."""
+
+
+class StalledError(PhysicsBreakdown):
     """Events keep arriving without the clock advancing: a numerical breakdown."""
 
+    stop_reason = "stalled"
 
-class ClosedBoxError(RuntimeError):
+
+class ClosedBoxError(PhysicsBreakdown):
     """Moving walls have squeezed the disks to jamming, or closed the box."""
 
+    stop_reason = "closed_box"
 
-class InelasticCollapseError(RuntimeError):
+
+class InelasticCollapseError(PhysicsBreakdown):
     """Inelastic collapse: a few disks collide infinitely often in finite time."""
+
+    stop_reason = "inelastic_collapse"
 
     def __init__(self, disks, time, collisions):
         self.disks = disks
@@ -88,7 +102,10 @@ class InelasticCollapseError(RuntimeError):
 
 
 #: wall numbers of :mod:`sim.walls` by name
-WALLS = {"left": 0, "right": 1, "bottom": 2, "top": 3}
+WALLS = {name: wall for wall, name in enumerate(NAMES)}
+
+#: The keys a wall's entry in ``walls`` may have.
+WALL_KEYS = ("temperature", "speed", "amplitude", "frequency")
 
 
 @dataclass(frozen=True)
@@ -98,6 +115,14 @@ class Boundary:
     size: tuple = (1.0, 1.0)
     periodic: tuple = (False, False)
 
+
+#: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
+#: take about this many seconds, from the rate of the chunk before, so that the budget is kept
+#: to about that; the first chunk has TIMED_FIRST_CHUNK events, none fewer than
+#: TIMED_MIN_CHUNK.
+TIMED_CHUNK_SECONDS = 0.15
+TIMED_FIRST_CHUNK = 20_000
+TIMED_MIN_CHUNK = 1_000
 
 #: A piston (a wall moving at constant speed) that has raised the kinetic energy this many
 #: times above max(initial energy, N m U²) has jammed the disks against the opposite wall:
@@ -125,6 +150,174 @@ def _closing_time(motion, box, periodic, largest_radius):
         if rate > 0.0:
             closing = min(closing, room / rate)
     return closing
+
+
+#: The stall guard of :func:`sim.event_loop.run_events` ends a run after more than
+#: 16 N + 1000 events in a row, each at most stall_dt = STALL_RESOLUTION · D / v after the one
+#: before (:func:`stall_interval`): D the far edge of the disks at the start (the largest
+#: x + R or y + R, the side of a periodic axis; the box side for disks that fill the box),
+#: whose ulps bound those of their coordinates, and v the fastest speed the scene sets (1 when
+#: it sets none). stall_dt is then the time in which such a disk moves 256–512 ulps of D: a
+#: float64 resolution, not a physical time. A chain of disks touching all round a periodic box
+#: creeps on by round-off, at most about 2 ulps of the box side per contact (measured), and is
+#: caught; the former guard, events at exactly one instant, never caught it.
+#:
+#: A real gas never trips it: the intervals between its events are near exponential, with
+#: mean m = (mean time between a disk's events) / N, and a run of k = 16 N + 1000 of them all
+#: below stall_dt has the chance (1 − exp(−stall_dt/m))^k, negligible until stall_dt/m comes
+#: near ln k ≈ 20. At φ = 0.8 in a unit box (v = 1) stall_dt/m is 9e-7 at N = 10⁴, and grows
+#: as N^1.5 (m ∝ R/N): 9e-4 at N = 10⁶, 20 only near N = 10⁹. In a very dilute gas a disk's
+#: events are its shell exits, a few radii R apart, so D counts at most STALL_RADII smallest
+#: radii: stall_dt/m stays below 2⁻³⁴ N. Disks settled under the TC model have an event every
+#: t_c or so, so a settled bed of N disks keeps clear of the guard while t_c ≫ 20 N stall_dt.
+STALL_RESOLUTION = 2.0**-44
+
+#: The largest D of :data:`STALL_RESOLUTION`, in smallest radii.
+STALL_RADII = 1024.0
+
+
+def stall_interval(length, box, initial_energy, mass, gravity, motion, temperature):
+    """stall_dt of :data:`STALL_RESOLUTION` for the length D = ``length``, from the fastest
+    of the initial rms speed, √(|g| L), the wall speeds |U| + A ω and √(T_w / m_min)
+    (float64; box (Lx, Ly), mass (n,), gravity, motion and temperature as :class:`Engine`
+    keeps them)."""
+    speeds = [math.sqrt(2.0 * initial_energy / float(mass.sum()))]
+    if gravity is not None:
+        speeds.append(math.sqrt(float(np.hypot(*gravity)) * float(np.max(box))))
+    if motion is not None:
+        speeds.append(float(np.max(np.abs(motion[:, 0]) + motion[:, 1] * motion[:, 2])))
+    if temperature is not None:
+        speeds.append(math.sqrt(float(np.nanmax(temperature)) / float(mass.min())))
+    fastest = max(speeds)
+    return STALL_RESOLUTION * length / (fastest if fastest > 0.0 else 1.0)
+
+
+def first_event_time(box, velocity, gravity, motion):
+    """A time by which some disk has its first event, within a factor of a few, when any
+    has one: the box's longer side crossed at the fastest speed the scene starts with, of a
+    disk, of a fall across the box (√(|g| L)) or of a wall (|U| + A ω); a disk's first
+    event, a shell exit or a contact, comes before it crosses a few shells or the box. One
+    time unit when nothing moves. box (Lx, Ly), velocity (n, 2); gravity and motion as
+    :class:`Engine` keeps them."""
+    side = float(np.max(box))
+    speeds = [math.sqrt(float(np.max(np.einsum("ij,ij->i", velocity, velocity))))]
+    if gravity is not None:
+        speeds.append(math.sqrt(float(np.hypot(*gravity)) * side))
+    if motion is not None:
+        speeds.append(float(np.max(np.abs(motion[:, 0]) + motion[:, 1] * motion[:, 2])))
+    fastest = max(speeds)
+    return side / fastest if fastest > 0.0 else 1.0
+
+
+def grid_cells(box, width, limit):
+    """Cells per axis (int64[2]) of a grid over ``box`` (Lx, Ly) whose cells are at least
+    ``width`` wide along both axes, at most ``limit`` cells in all: as many as fit, else fewer
+    in proportion to the sides. Wider cells than needed are correct, only slower; the count
+    is formed in float64, as box / width may exceed int64 (tiny disks in a huge box), or even
+    float64, whose inf the clip takes back to ``limit``."""
+    with np.errstate(over="ignore"):
+        fit = np.clip(np.floor(np.asarray(box, dtype=np.float64) / width), 1.0, limit)
+    if fit[0] * fit[1] > limit:
+        shrink = math.sqrt(fit[0] * fit[1] / limit)
+        across = max(1.0, math.floor(fit[0] / shrink))
+        fit = np.array([across, min(fit[1], max(1.0, math.floor(limit / across)))])
+    return fit.astype(np.int64)
+
+
+def cell_limit(n):
+    """Most cells a grid for ``n`` disks may have: a few per disk."""
+    return max(4 * n, 64)
+
+
+@njit(cache=True)
+def _first_overlap(position, radius, level, reach, cells, box, periodic, tolerance):
+    """The first disk, in the given order, that overlaps a disk before it:
+    (i, j, distance) with j the earliest disk it overlaps, or (-1, -1, 0.0) when none does.
+    Overlap: |r_i − r_j| < (R_i + R_j)(1 − tolerance), minimum image on periodic axes.
+
+    Each disk is checked against the disks filed before it, then filed itself, in a grid per
+    radius level (``level`` int64[n], 0 … K−1; level k has radii up to ``reach[k]`` and
+    ``cells[k]`` (``cells`` int64[K, 2]) cells, each at least 2 ``reach[k]`` wide, no more
+    than :func:`cell_limit` of its number of disks). The disks filed never overlap, so a cell
+    holds a few of them when the disks spread over the box, and the cost is O(N K) for K
+    levels, also when most disks overlap (the check stops at the first); disks crowded into a
+    corner of a box far larger than they crowd the cells, as they do the engine's own.
+
+    position float64[n, 2] (inside the box, or wrapped into it on periodic axes), radius
+    float64[n], box float64[2], periodic bool[2].
+    """
+    n = position.shape[0]
+    n_levels = reach.shape[0]
+    first_cell = np.zeros(n_levels + 1, dtype=np.int64)
+    for k in range(n_levels):
+        first_cell[k + 1] = first_cell[k] + cells[k, 0] * cells[k, 1]
+    head = np.full(first_cell[n_levels], -1, dtype=np.int64)
+    following = np.full(n, -1, dtype=np.int64)
+    for i in range(n):
+        x = position[i, 0]
+        y = position[i, 1]
+        found = -1
+        found_distance = 0.0
+        for k in range(n_levels):
+            nx = cells[k, 0]
+            ny = cells[k, 1]
+            width_x = box[0] / nx
+            width_y = box[1] / ny
+            cx = min(int(x / width_x), nx - 1)
+            cy = min(int(y / width_y), ny - 1)
+            kx = int(math.ceil((radius[i] + reach[k]) / width_x))
+            ky = int(math.ceil((radius[i] + reach[k]) / width_y))
+            if periodic[0] and 2 * kx + 1 < nx:
+                x_lo, x_hi = cx - kx, cx + kx + 1
+            else:
+                x_lo, x_hi = max(cx - kx, 0), min(cx + kx + 1, nx)
+            if periodic[1] and 2 * ky + 1 < ny:
+                y_lo, y_hi = cy - ky, cy + ky + 1
+            else:
+                y_lo, y_hi = max(cy - ky, 0), min(cy + ky + 1, ny)
+            for ay in range(y_lo, y_hi):
+                row = first_cell[k] + (ay % ny) * nx
+                for ax in range(x_lo, x_hi):
+                    j = head[row + ax % nx]
+                    while j >= 0:
+                        dx = minimum_image(x - position[j, 0], box[0], periodic[0])
+                        dy = minimum_image(y - position[j, 1], box[1], periodic[1])
+                        distance = math.sqrt(dx * dx + dy * dy)
+                        if (distance < (radius[i] + radius[j]) * (1.0 - tolerance)
+                                and (found < 0 or j < found)):
+                            found = j
+                            found_distance = distance
+                        j = following[j]
+        if found >= 0:
+            return i, found, found_distance
+        k = level[i]
+        nx = cells[k, 0]
+        c = (first_cell[k] + min(int(y / (box[1] / cells[k, 1])), cells[k, 1] - 1) * nx
+             + min(int(x / (box[0] / nx)), nx - 1))
+        following[i] = head[c]
+        head[c] = i
+    return -1, -1, 0.0
+
+
+def first_overlap(position, radius, box, periodic, tolerance=1e-9):
+    """(i, j, distance) of the first disk i, in the given order, that overlaps a disk j before
+    it (the earliest such j), or None; see :func:`_first_overlap`. Radii are grouped in
+    levels a factor 2 apart, so that small disks are not filed in cells sized for large ones.
+    """
+    octave = np.floor(np.log2(radius / radius.min())).astype(np.int64)
+    present = np.flatnonzero(np.bincount(octave))
+    number = np.zeros(present[-1] + 1, dtype=np.int64)
+    number[present] = np.arange(present.size)
+    level = number[octave]
+    reach = np.zeros(present.size)
+    np.maximum.at(reach, level, radius)
+    count = np.bincount(level)
+    cells = np.array([grid_cells(box, 2.0 * reach[k], cell_limit(int(count[k])))
+                      for k in range(present.size)])
+    i, j, distance = _first_overlap(position, radius, level, reach, cells,
+                                    np.asarray(box, dtype=np.float64),
+                                    np.asarray(periodic, dtype=np.bool_), float(tolerance))
+    return None if i < 0 else (int(i), int(j), float(distance))
 
 
 def _interpolate(table, packing_fraction):
@@ -177,15 +370,140 @@ def packing_fraction_around_disks(position, radius, box):
     return float(np.sum(count * covered) / (bin_area * n))
 
 
+def _first(mask):
+    """Index of the first True entry of the bool array ``mask``, or None."""
+    bad = np.flatnonzero(mask)
+    return int(bad[0]) if bad.size else None
+
+
+def _check_disks(position, velocity, radius, mass, species):
+    """Refuse non-finite positions and velocities (n, 2), radii and masses (n,) that are not
+    finite and > 0, and negative species, naming the first disk at fault."""
+    for name, values in (("radius", radius), ("mass", mass)):
+        bad = _first(~((values > 0.0) & (values < math.inf)))
+        if bad is not None:
+            raise ValueError(f"disk {bad} has {name} {values[bad]}: a {name} must be finite "
+                             f"and > 0")
+    for name, values in (("position", position), ("velocity", velocity)):
+        bad = _first(~np.isfinite(values.ravel()))
+        if bad is not None:
+            raise ValueError(f"disk {bad // 2} has {name} {values[bad // 2].tolist()}: "
+                             f"positions and velocities must be finite")
+    bad = _first(species < 0)
+    if bad is not None:
+        raise ValueError(f"disk {bad} has species {species[bad]}: species are integers ≥ 0")
+
+
+def _box_size(boundary):
+    """The box sides float64[2] of a :class:`Boundary`, refused unless finite and > 0."""
+    box = np.array(boundary.size, dtype=np.float64).reshape(-1)
+    if box.shape != (2,) or not np.all((box > 0.0) & (box < math.inf)):
+        raise ValueError(f"box size must be two finite sides > 0, got {boundary.size}")
+    return box
+
+
+def _check_inside(given, position, radius, box, periodic):
+    """Refuse a disk reaching beyond a wall (R ≤ x ≤ L − R on a walled axis), naming the
+    first; ``given`` are the positions as the caller gave them, ``position`` wrapped."""
+    for axis in range(2):
+        if not periodic[axis]:
+            bad = _first((position[:, axis] - radius < 0.0)
+                         | (position[:, axis] + radius > box[axis]))
+            if bad is not None:
+                raise ValueError(f"disk {bad} at {given[bad].tolist()} with radius "
+                                 f"{radius[bad]} pokes through a wall of the box "
+                                 f"{box.tolist()}: along a walled axis of side L a disk of "
+                                 f"radius R needs R ≤ x ≤ L − R")
+
+
+def _wall_specs(walls, periodic):
+    """``walls`` as :class:`Engine` takes them (name → {key: value}), checked and keyed by
+    wall number (:mod:`sim.walls`); walls without an entry stay hard and still."""
+    walls = {} if walls is None else dict(walls)
+    for name, spec in walls.items():
+        if name not in WALLS:
+            raise ValueError(f"unknown wall {name!r}: use {', '.join(WALLS)}")
+        unknown = sorted(set(spec or {}) - set(WALL_KEYS))
+        if unknown:
+            raise ValueError(f"{name} wall: unknown keys {unknown}, use {', '.join(WALL_KEYS)}")
+        if spec and periodic[WALLS[name] >> 1]:
+            raise ValueError(f"{name} wall is given on a periodic axis, which has no walls")
+    return {WALLS[name]: dict(spec) for name, spec in walls.items() if spec}
+
+
+#: float64 squares and multiplies the scales of a scene in its roots, impulses and energies:
+#: each length (box sides, radii), speed (the fastest disk, |U| + A ω of a wall, √(|g| L) of
+#: gravity, √(T_w/m) of a thermal wall) and mass must lie in [1/SCALE_LIMIT, SCALE_LIMIT], so
+#: that their squares and products keep far inside its normal range (1e-308 … 1e308).
+SCALE_LIMIT = 1e60
+
+#: The smallest radius must be at least this fraction of the far edge D of the disks (the
+#: largest x + R or y + R, the side of a periodic axis): coordinates near D are resolved to
+#: 2⁻⁵² D, and the contacts of smaller disks could not be located to 2⁻¹² of their radius.
+RESOLUTION_LIMIT = 2.0**-40
+
+
+def _check_scales(box, radius, mass, velocity, extent, gravity, motion, temperature):
+    """Refuse a scene that float64 cannot hold (:data:`SCALE_LIMIT`, :data:`RESOLUTION_LIMIT`),
+    naming the parameter at fault. box (Lx, Ly), radius, mass (n,), velocity (n, 2),
+    ``extent`` the far edge of the disks; gravity, motion, temperature as :class:`Engine`
+    keeps them."""
+    def check(name, value):
+        if not 1.0 / SCALE_LIMIT <= value <= SCALE_LIMIT:
+            raise ValueError(f"{name} is {value:.3g}: it must lie in [{1.0 / SCALE_LIMIT:g}, "
+                             f"{SCALE_LIMIT:g}], as float64 squares and multiplies the lengths, "
+                             f"speeds and masses of a scene")
+
+    for axis in range(2):
+        check(f"the box side along {'xy'[axis]}", box[axis])
+    for name, values in (("radius", radius), ("mass", mass)):
+        for i in (int(np.argmin(values)), int(np.argmax(values))):
+            check(f"the {name} of disk {i}", values[i])
+    with np.errstate(over="ignore"):
+        fastest = int(np.argmax(np.einsum("ij,ij->i", velocity, velocity)))
+    speed = float(np.hypot(*velocity[fastest]))
+    # disks at rest set no speed scale, and slower ones only relative speeds, which may be tiny
+    if speed > 0.0:
+        check(f"the speed of disk {fastest}", speed)
+    if gravity is not None:
+        check("√(|g| L), the speed of a fall across the box,",
+              math.sqrt(float(np.hypot(*gravity)) * float(np.max(box))))
+    for wall in range(4):
+        if motion is not None and np.any(motion[wall, :2]):
+            check(f"the speed |U| + A ω of the {NAMES[wall]} wall",
+                  abs(motion[wall, 0]) + motion[wall, 1] * motion[wall, 2])
+        if temperature is not None and not math.isnan(temperature[wall]):
+            for m in (mass.min(), mass.max()):
+                check(f"√(T_w / m) of the {NAMES[wall]} wall for mass {m:g}",
+                      math.sqrt(temperature[wall] / m))
+    i = int(np.argmin(radius))
+    if radius[i] < RESOLUTION_LIMIT * extent:
+        raise ValueError(f"the radius of disk {i} is {radius[i]:.3g}, less than 2**-40 of the "
+                         f"far edge of the disks ({extent:.3g}; the largest x + R or y + R, the "
+                         f"side of a periodic axis): float64 coordinates there cannot resolve "
+                         f"its contacts; radii must be at least {RESOLUTION_LIMIT * extent:.3g}")
+
+
+def _seed(seed):
+    """The thermal walls' seed as the compiled generator takes it (int64 ≥ 0)."""
+    try:
+        value = operator.index(seed)
+    except TypeError:
+        value = None
+    if value is None or not 0 <= value <= np.iinfo(np.int64).max:
+        raise ValueError(f"seed must be an integer in [0, 2**63 - 1], got {seed!r}")
+    return value
+
+
 def _restitution_matrix(restitution, n_species):
     """None for elastic contacts (the effect is dropped), else float64[s, s]."""
     if restitution is None:
         return None
     xi = np.broadcast_to(np.asarray(restitution, dtype=np.float64), (n_species, n_species))
+    if not np.all((xi >= 0.0) & (xi <= 1.0)):
+        raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
     if not np.array_equal(xi, xi.T):
         raise ValueError(f"restitution matrix must be symmetric, got {xi.tolist()}")
-    if np.any(xi < 0.0) or np.any(xi > 1.0):
-        raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
     if np.all(xi == 1.0):
         return None
     # always a fresh writable copy: numba types read-only arrays apart, so a view passed on
@@ -247,55 +565,47 @@ class Engine:
         mass = np.array(np.broadcast_to(np.asarray(mass, np.float64), (n,)))
         species = (np.zeros(n, np.int32) if species is None
                    else np.array(np.broadcast_to(np.asarray(species), (n,)), dtype=np.int32))
-        if np.any(radius <= 0) or not np.all(np.isfinite(radius)):
-            raise ValueError("radius must be positive and finite")
-        if np.any(mass <= 0) or not np.all(np.isfinite(mass)):
-            raise ValueError("mass must be positive and finite")
-        if np.any(species < 0):
-            raise ValueError("species must be non-negative integers")
-        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
-            raise ValueError("positions and velocities must be finite")
-        box = np.array(boundary.size, dtype=np.float64)
+        _check_disks(position, velocity, radius, mass, species)
+        box = _box_size(boundary)
         periodic = np.array(boundary.periodic, dtype=bool)
         self.boundary = boundary
         self.n = n
         self.n_species = int(species.max()) + 1
         self.box = box
         self.periodic = periodic
+        given = position
         position = np.where(periodic, position % box, position)
-        for axis in range(2):
-            if not periodic[axis]:
-                low = position[:, axis] - radius
-                high = position[:, axis] + radius
-                if np.any(low < 0.0) or np.any(high > box[axis]):
-                    bad = int(np.flatnonzero((low < 0.0) | (high > box[axis]))[0])
-                    raise ValueError(f"disk {bad} at {position[bad].tolist()} with radius "
-                                     f"{radius[bad]} pokes through a wall of the box "
-                                     f"{box.tolist()}")
+        _check_inside(given, position, radius, box, periodic)
 
         self.restitution = _restitution_matrix(restitution, self.n_species)
         if wall_restitution is not None and not 0.0 <= wall_restitution <= 1.0:
             raise ValueError(f"wall_restitution must lie in [0, 1], got {wall_restitution}")
         self.wall_restitution = (None if wall_restitution is None or wall_restitution == 1.0
                                  else float(wall_restitution))
-        if tc is not None and tc < 0:
-            raise ValueError(f"tc must be ≥ 0 or None, got {tc}")
+        if tc is not None and not 0.0 <= tc < math.inf:
+            raise ValueError(f"tc (the TC-model time) must be finite and ≥ 0, or None; got {tc}")
         dissipative = self.restitution is not None or self.wall_restitution is not None
         self.tc = float(tc) if (tc and dissipative) else None
         self.gravity = gravity_vector(gravity)
         if self.gravity is not None and np.any(self.gravity[periodic] != 0.0):
             raise ValueError(f"gravity {self.gravity.tolist()} has a component along a periodic "
                              f"axis, where nothing stops the fall; give it walls")
-        walls = {} if walls is None else dict(walls)
-        unknown = set(walls) - set(WALLS)
-        if unknown:
-            raise ValueError(f"unknown walls {sorted(unknown)}: use {', '.join(WALLS)}")
-        if any(periodic[WALLS[name] >> 1] for name, spec in walls.items() if spec):
-            raise ValueError(f"walls {walls} are given on a periodic axis, which has none")
-        by_number = {WALLS[name]: dict(spec) for name, spec in walls.items() if spec}
+        by_number = _wall_specs(walls, periodic)
         self.wall_motion = wall_motion(by_number)
         self.wall_temperature = wall_temperature(by_number)
-        self.seed = int(seed)
+        self.seed = _seed(seed)
+        # the far edge of the disks, whose ulps bound those of their coordinates (a disk
+        # crossing a periodic axis reappears near its far side)
+        extent = max(float(box[axis]) if periodic[axis]
+                     else float(np.max(position[:, axis] + radius)) for axis in range(2))
+        _check_scales(box, radius, mass, velocity, extent, self.gravity, self.wall_motion,
+                      self.wall_temperature)
+        overlap = first_overlap(position, radius, box, periodic)
+        if overlap is not None:
+            i, j, distance = overlap
+            raise ValueError(f"disk {i} at {given[i].tolist()} overlaps disk {j} (distance "
+                             f"{distance:.6g} < contact distance {radius[i] + radius[j]:.6g}): "
+                             f"disks may touch but not overlap")
         self.closing_time = _closing_time(self.wall_motion, box, periodic, float(radius.max()))
 
         self.radius = radius
@@ -322,11 +632,17 @@ class Engine:
         self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
                                   else float(collapse_interval))
         self.collapse_streak = int(collapse_streak)
-        self._build(position, velocity, shell, shell_lead, list_capacity, unwrap)
+        self.stall_dt = stall_interval(min(extent, STALL_RADII * float(radius.min())), box,
+                                       self.initial_energy, mass, self.gravity,
+                                       self.wall_motion, self.wall_temperature)
+        self.stall_watch = np.array([-math.inf, 0.0])
+        self._build(position, velocity, shell, shell_lead, list_capacity, unwrap,
+                    first_event_time(box, velocity, self.gravity, self.wall_motion))
 
     # -- construction ---------------------------------------------------------------------
-    def _build(self, position, velocity, shell, lead, list_capacity, unwrap):
-        """Size shells and cells, allocate the state, link neighbours, schedule events."""
+    def _build(self, position, velocity, shell, lead, list_capacity, unwrap, first_event):
+        """Size shells and cells, allocate the state, link neighbours, schedule events;
+        ``first_event``: :func:`first_event_time`."""
         n, radius, box = self.n, self.radius, self.box
         median = float(np.median(radius))
         big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
@@ -361,7 +677,7 @@ class Engine:
                 delta_small = min(delta_small, limit)
         delta = np.full(n, delta_small)
         reach = max_small + delta_small
-        cells = np.maximum(1, np.floor(box / (2.0 * reach)).astype(np.int64))
+        cells = grid_cells(box, 2.0 * reach, cell_limit(n))
         self.geometry = np.array([box[0], box[1], box[0] / cells[0], box[1] / cells[1], reach,
                                   lead])
         self.grid = np.array([cells[0], cells[1], int(self.periodic[0]), int(self.periodic[1])],
@@ -398,12 +714,21 @@ class Engine:
             self._grow_lists(full)
         # first predictions: every disk queued at t = 0 and predicted by the event loop itself
         # (with the argument types of every later call) in a call that may apply no event;
-        # then the queue is sized for the predicted events
+        # then the queue is sized for the predicted events. Until then its blocks are sized
+        # for the scene's first events (:func:`first_event_time`): a width of one time unit
+        # would put the earliest prediction of disks slow against their box beyond the int64
+        # blocks the queue's years reach, and the queue would look for it for ever. A contact
+        # due at once (τ = 0) ends the call early, at the head of the queue: the other disks
+        # are then predicted in the first run, in this queue, until the clock's first rebase
+        # sizes it anew.
         d.event_time[:] = 0.0
         d.event_partner[:] = loop.UNPREDICTED
         build_queue(*d.queue, d.event_time, 0.0)
+        d.block_rate[0] = n / (BLOCK_EVENTS * first_event)
         self._run_chunk(0, 0, 0, 0.0, np.inf)
-        build_queue(*d.queue, d.event_time, 0.0)
+        if not np.any(d.event_partner == loop.UNPREDICTED):
+            build_queue(*d.queue, d.event_time, 0.0)
+        self.stall_watch[:] = (-math.inf, 0.0)  # the first predictions, all at t = 0, are no run
         if n >= REORDER_MIN_DISKS:
             self.reorder()
 
@@ -484,8 +809,8 @@ class Engine:
                 self.accumulators, self.pair_collisions, self.wall_impulse,
                 min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
                 dissipation_limit,
-                self.collapse_interval, self.collapse_streak, self.rebase_every,
-                self.lookahead)
+                self.collapse_interval, self.collapse_streak, self.stall_dt, self.stall_watch,
+                self.rebase_every, self.lookahead)
             self.drain_event_log()
             if status == loop.STATUS_LOG_FULL:
                 continue
@@ -497,13 +822,16 @@ class Engine:
                 self._grow_lists(disk)
                 continue
             if status == loop.STATUS_STALLED:
+                self._check_piston()  # a jammed piston stalls the clock too: say so
                 raise StalledError(
-                    f"the clock is stuck at t = {self.time:.17g}: more than 16 N + 1000 events "
-                    f"in a row at one instant, last for disk {d.order[disk]} at position "
+                    f"the clock has stalled at t = {self.time:.17g}: more than 16 N + 1000 "
+                    f"events in a row, each within {self.stall_dt:.3g} (float64 resolution) of "
+                    f"the one before, last for disk {d.order[disk]} at position "
                     f"{d.table[disk, X:Y + 1].tolist()} with velocity "
-                    f"{d.table[disk, VX:VY + 1].tolist()}; the state is beyond float64 resolution "
-                    f"(for inelastic disks, and for disks resting on a wall under gravity, "
-                    f"switch on the TC model)")
+                    f"{d.table[disk, VX:VY + 1].tolist()}; the state is beyond float64 "
+                    f"resolution: for inelastic disks, and for disks resting on a wall under "
+                    f"gravity, switch on the TC model (tc.time); a chain of disks touching all "
+                    f"round a periodic box needs room between its disks")
             if status == loop.STATUS_COLLAPSE:
                 cluster = set(np.flatnonzero(d.streak >= 2).tolist()) | {int(disk)}
                 raise InelasticCollapseError(sorted(int(d.order[k]) for k in cluster),
@@ -518,9 +846,14 @@ class Engine:
         collisions : disk–disk contacts since the start of the engine
         time : absolute simulated time; the run stops at the last event not after it
         energy_fraction : stop once the kinetic energy is this fraction of the initial one
-        wall_seconds : wall-clock budget of this call, checked between chunks
+        wall_seconds : wall-clock budget of this call, checked between chunks, which are then
+            sized to take about :data:`TIMED_CHUNK_SECONDS` each (from the rate of the chunk
+            before; the first has :data:`TIMED_FIRST_CHUNK` events)
         until : predicate ``until(engine) -> bool`` checked between chunks
-        chunk_events : events per compiled call
+        chunk_events : events per compiled call (the most, with ``wall_seconds``)
+
+        The piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended
+        it. Chunk sizes change no result: the same inputs give the same bits.
         """
         if all(x is None for x in (events, collisions, time, energy_fraction, wall_seconds,
                                    until)):
@@ -538,10 +871,14 @@ class Engine:
                    loop.STATUS_TIME_REACHED: "time",
                    loop.STATUS_ENERGY_REACHED: "energy_fraction",
                    loop.STATUS_NO_EVENTS: "no_events"}
+        chunk = int(chunk_events) if wall_seconds is None else min(int(chunk_events),
+                                                                   TIMED_FIRST_CHUNK)
         while True:
-            chunk_end = int(self.counters[loop.EVENTS]) + int(chunk_events)
-            status = self._run_chunk(chunk_end, max_contacts, max_collisions, t_stop,
+            chunk_started = wallclock.perf_counter()
+            steps = self.steps
+            status = self._run_chunk(steps + chunk, max_contacts, max_collisions, t_stop,
                                      dissipation_limit)
+            self._check_piston()
             if status != loop.STATUS_EVENT_LIMIT:
                 if closing and status == loop.STATUS_TIME_REACHED:
                     raise ClosedBoxError(
@@ -549,15 +886,19 @@ class Engine:
                         f"largest disk diameter ({2 * self.radius.max():.6g}) of the opposite "
                         f"wall: stop the run earlier (stop.time) or slow the piston")
                 return reasons[status]
-            self._check_piston()
-            if wall_seconds is not None and wallclock.perf_counter() - started >= wall_seconds:
-                return "wall_seconds"
+            if wall_seconds is not None:
+                now = wallclock.perf_counter()
+                if now - started >= wall_seconds:
+                    return "wall_seconds"
+                rate = (self.steps - steps) / max(now - chunk_started, 1e-6)
+                chunk = int(np.clip(rate * TIMED_CHUNK_SECONDS, TIMED_MIN_CHUNK, chunk_events))
             if until is not None and until(self):
                 return "predicate"
 
     def _check_piston(self):
         """Raise :class:`ClosedBoxError` when a piston has jammed the disks (see
-        :data:`PISTON_ENERGY_LIMIT`); checked between chunks."""
+        :data:`PISTON_ENERGY_LIMIT`); checked after every chunk, so within one chunk of the
+        jam."""
         if self.wall_motion is None or not np.any(self.wall_motion[:, 0]):
             return
         speed = float(np.abs(self.wall_motion[:, 0]).max())
@@ -620,7 +961,19 @@ class Engine:
         return state
 
     def load_state_dict(self, state):
-        """Replace the evolving arrays by those of :meth:`state_dict` (copied)."""
+        """Replace the evolving arrays by those of :meth:`state_dict` (copied). A state of
+        another scene — other arrays, or arrays of other shapes than this engine's (the
+        neighbour lists ``disks/nb`` aside, which grow) — is refused with a ValueError before
+        anything is replaced."""
+        mine = {key: np.shape(value) for key, value in self.state_dict().items()}
+        missing, unknown = sorted(set(mine) - set(state)), sorted(set(state) - set(mine))
+        if missing or unknown:
+            raise ValueError(f"the checkpoint is not one of this scene's engine: arrays "
+                             f"missing {missing}, unknown {unknown}")
+        for key, value in state.items():
+            if key != "disks/nb" and np.shape(value) != mine[key]:
+                raise ValueError(f"the checkpoint's {key} has shape {np.shape(value)}, this "
+                                 f"scene's engine {mine[key]}")
         for key, value in state.items():
             value = np.array(value)
             if key.startswith("disks/"):
@@ -630,6 +983,7 @@ class Engine:
             else:
                 setattr(self, key, value)
         self._common_capacity = common_value(self.disks.nb_cap)
+        self.stall_watch[:] = (-math.inf, 0.0)  # its times ran on the clock it replaced
 
     def _user_order(self, values):
         out = np.empty_like(values)

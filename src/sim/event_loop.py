@@ -299,7 +299,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                seed, images, virial_tensor, event_log, log_fill,
                counters, accumulators, pair_collisions, wall_impulse,
                max_events, max_contacts, max_collisions, t_stop, dissipation_limit,
-               collapse_dt, collapse_streak, rebase_every, lookahead):
+               collapse_dt, collapse_streak, stall_dt, stall_watch, rebase_every, lookahead):
     """Process events in time order until a limit is met; see the module docstring.
 
     Limits: ``max_events`` (applied events, shell exits included: the chunk size),
@@ -309,7 +309,10 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     dissipation ends the run. Inelastic collapse: a disk with more than ``collapse_streak``
     consecutive dissipative contacts, each less than ``collapse_dt`` after its previous
     contact (contacts made elastic by the TC model break the streak). A stall — more than
-    16 N + 1000 events in a row at one instant — ends the loop instead of hanging it.
+    16 N + 1000 events in a row, each at most ``stall_dt`` after the one before (a time of
+    float64 resolution, :data:`sim.engine.STALL_RESOLUTION`) — ends the loop instead of
+    hanging it; ``stall_watch`` float64[2] holds the time of the last event popped (relative
+    clock) and the length of that run, carried from one call to the next.
 
     ``lookahead``: prefetch several events ahead, and the candidates of a shell exit's cell
     scan, for states larger than the caches (:func:`prefetch_upcoming`,
@@ -334,8 +337,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     events_to_rebase = rebase_every - events % rebase_every
     status = 0
     culprit = -1
-    t_previous = -INF
-    stalled = 0
+    t_previous = stall_watch[0]
+    stalled = np.int64(stall_watch[1])
     stall_limit = 16 * disks.shape[0] + 1000
     walker = -1  # the queue's look-ahead (prefetch_next_block)
     walker_block = -1
@@ -365,7 +368,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
         if t == INF:
             status = STATUS_NO_EVENTS
             break
-        if t == t_previous:
+        if t - t_previous <= stall_dt:
             stalled += 1
             if stalled > stall_limit:
                 status = STATUS_STALLED
@@ -373,7 +376,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                 break
         else:
             stalled = 0
-            t_previous = t
+        t_previous = t
         walker, walker_block = prefetch_upcoming(
             partner, lookahead, walker, walker_block, disks, delta, coll_count, event_time,
             event_partner, event_count, heap, links, list_head, calendar, nb_start, nb_count, nb,
@@ -494,6 +497,7 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
                          list_head, calendar, block_rate, geometry, grid, gravity, images,
                          accumulators)
             t_now = 0.0
+            t_previous = 0.0  # this event's time, on the restarted clock
             t_stop_rel = t_stop - accumulators[T_ORIGIN]
             events_to_rebase = rebase_every
     counters[EVENTS] = events
@@ -506,6 +510,8 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     accumulators[DISSIPATED_WALLS] = dissipated_walls
     accumulators[VIRIAL] = virial_sum
     accumulators[WALL_WORK] = wall_work
+    stall_watch[0] = t_previous
+    stall_watch[1] = stalled
     return status, culprit
 
 

@@ -4,30 +4,59 @@
 file exists), then advances the engine in compiled chunks from snapshot to snapshot, writing
 each to the H5MD run file, until a stop condition holds. :func:`resume` continues a run file
 from its last checkpoint to the same bits as a run never interrupted.
+
+One run file, one process (:mod:`sim.run_folder`): a run holds the lock of its run file from
+the first look at its folder to its last write, writes a new file under a hidden name until
+its first checkpoint is on disk, and finds in its folder either nothing, its own run (complete:
+returned as it is; cut short: resumed) or another config's run (refused, naming the keys that
+differ). Every run ends by a stop condition, its wall-clock budget, SIGINT or SIGTERM (a final
+snapshot and checkpoint, resumable), or a breakdown of the physics (recorded as the stop
+reason, :class:`sim.engine.PhysicsBreakdown`).
 """
 
+import errno
+import logging
 import math
 import signal
 import subprocess
 import sys
 import threading
 import time as wallclock
+from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
 import numpy as np
+import yaml
 from omegaconf import OmegaConf
+from omegaconf.errors import ValidationError
 from tqdm import tqdm
 
 import sim
+from sim import resources
 from sim.config import ConfigError, SimConfig, validate
-from sim.engine import Engine
-from sim.h5md import DiskFullError, RunWriter, read_checkpoint
+from sim.engine import Engine, PhysicsBreakdown
+from sim.h5md import DiskFullError, RunWriter, hdf5_reason, read_checkpoint
+from sim.inspect import RunFileError as UnreadableRunFile
+from sim.inspect import open_run_file
 from sim.observers import from_config as observers_from_config
+from sim.run_folder import FolderBusyError, RunLock, part_path, publish
 from sim.scenes import build_scene
+from sim.stop_conditions import already_met, at_rest, check_reachable
+
+log = logging.getLogger(__name__)
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
 FINISHED = ("collisions", "events", "time", "energy_fraction", "at_rest", "no_events")
+
+#: Keys a resume may change: when the run stops, how often it writes, what it shows.
+RESUMABLE = ("stop.collisions", "stop.events", "stop.time", "stop.energy_fraction",
+             "stop.at_rest", "stop.wall_seconds", "output.every_collisions",
+             "output.every_time", "output.progress")
+
+#: Keys in which a run asked for again into its own folder may differ from the run there:
+#: neither changes what is simulated or written.
+COSMETIC = ("stop.wall_seconds", "output.progress")
 
 
 class RunFileError(OSError):
@@ -35,38 +64,47 @@ class RunFileError(OSError):
 
 
 class Interruption:
-    """SIGINT (Ctrl-C) asks the run to stop: the engine finishes its compiled chunk, the
-    runner writes a final snapshot and checkpoint, and the run ends with stop reason
-    ``interrupted`` (``resume`` continues it). A second SIGINT interrupts at once. Installed
-    only in the main thread, and only for the run."""
+    """SIGINT (Ctrl-C) or SIGTERM (a batch scheduler's time limit) asks the run to stop: the
+    engine finishes its compiled chunk, the runner writes a final snapshot and checkpoint,
+    and the run ends with stop reason ``interrupted`` or ``terminated`` (``resume``
+    continues it). A second signal acts at once: :attr:`at_second_signal` (the command line
+    leaves the process there, as SIGKILL would; by default a KeyboardInterrupt is raised).
+    Installed only in the main thread, and only for the run."""
+
+    REASONS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+    #: ``f(signal)`` called at a second signal; None: raise KeyboardInterrupt
+    at_second_signal = None
 
     def __init__(self):
-        self.requested = False
-        self._previous = None
+        self.signal = None
+        self._previous = {}
+
+    @property
+    def requested(self):
+        return self.signal is not None
+
+    @property
+    def reason(self):
+        return self.REASONS[self.signal]
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self._request)
+            for number in self.REASONS:
+                self._previous[number] = signal.signal(number, self._request)
         return self
 
     def _request(self, signum, frame):
-        self.requested = True
-        signal.signal(signal.SIGINT, self._previous)
+        if self.signal is None:
+            self.signal = signal.Signals(signum)
+        elif Interruption.at_second_signal is not None:
+            Interruption.at_second_signal(signal.Signals(signum))
+        else:
+            raise KeyboardInterrupt
 
     def __exit__(self, *exc):
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
+        for number, previous in self._previous.items():
+            signal.signal(number, previous)
         return False
-
-
-def at_rest(fraction):
-    """Stop predicate of ``stop.at_rest``: the kinetic energy of every species has fallen below
-    ``fraction`` of the initial total. Hard-disk dynamics has no energy scale (a run at
-    speeds ×λ is the same run in time /λ, unless the TC model's fixed t_c intervenes), so it
-    ends runs that differ only in their speeds at the same stage."""
-    def predicate(engine):
-        return bool(np.all(engine.kinetic_energy_by_species() < fraction * engine.initial_energy))
-    return predicate
 
 
 def _git_commit():
@@ -78,15 +116,16 @@ def _git_commit():
         return "unknown"
 
 
-def parameters(cfg):
-    """What /parameters records: the resolved config, seed, versions, commit."""
-    import h5py as _h5py
+def parameters(cfg, overrides=()):
+    """What /parameters records: the resolved config, the overrides that made it, seed,
+    versions, commit."""
     import numba
 
     return {"config": OmegaConf.to_yaml(cfg, resolve=True), "seed": int(cfg.seed),
+            "overrides": yaml.safe_dump(list(overrides)),
             "versions": f"sim {sim.__version__}, python {sys.version.split()[0]}, numpy "
                         f"{np.__version__}, numba {numba.__version__}, h5py "
-                        f"{_h5py.__version__}",
+                        f"{h5py.__version__}",
             "git_commit": _git_commit()}
 
 
@@ -127,43 +166,57 @@ def _progress(cfg, engine):
                 disable=disable, dynamic_ncols=True)
 
 
-def advance(engine, cfg, writer, last_time):
+def every_collisions(cfg, n):
+    """Collisions between snapshots: ``output.every_collisions``, or ``n`` (one collision
+    per disk) when neither it nor ``output.every_time`` is given; None for a cadence in
+    time."""
+    out = cfg.output
+    if out.every_collisions is not None:
+        return int(out.every_collisions)
+    return None if out.every_time is not None else int(n)
+
+
+def advance(engine, cfg, writer, last_time, started, interruption):
     """Run from snapshot to snapshot (the last one at ``last_time``) until a stop condition
-    holds or SIGINT arrives (:class:`Interruption`); returns the stop reason."""
-    with Interruption() as interruption:
-        return _advance(engine, cfg, writer, last_time, interruption)
-
-
-def _advance(engine, cfg, writer, last_time, interruption):
+    holds, the wall-clock budget (counted from ``started``, a ``time.perf_counter()``) is
+    spent, or SIGINT or SIGTERM arrives (``interruption``, an entered
+    :class:`Interruption`); returns the stop reason."""
     stop, out = cfg.stop, cfg.output
     resting = None if stop.at_rest is None else at_rest(stop.at_rest)
+    cadence = every_collisions(cfg, engine.n)
 
     def until(engine):
         return interruption.requested or (resting is not None and resting(engine))
 
-    started = wallclock.perf_counter()
+    def budget():
+        if stop.wall_seconds is None:
+            return None
+        return max(stop.wall_seconds - (wallclock.perf_counter() - started), 0.0)
+
     bar = _progress(cfg, engine)
     try:
         while True:
-            next_collisions = (engine.collisions + out.every_collisions
-                               if out.every_collisions else None)
+            next_collisions = engine.collisions + cadence if cadence else None
             next_time = last_time + out.every_time if out.every_time else None
             collisions = min(x for x in (stop.collisions, next_collisions, math.inf)
                              if x is not None)
             t_stop = min(x for x in (stop.time, next_time, math.inf) if x is not None)
-            budget = (None if stop.wall_seconds is None
-                      else max(stop.wall_seconds - (wallclock.perf_counter() - started), 0.0))
             reason = engine.run(
                 events=stop.events, collisions=None if collisions == math.inf else collisions,
                 time=None if t_stop == math.inf else t_stop,
-                energy_fraction=stop.energy_fraction, wall_seconds=budget, until=until)
+                energy_fraction=stop.energy_fraction, wall_seconds=budget(), until=until)
             snapshot_time = t_stop if reason == "time" else None
-            if reason == "no_events" and t_stop < math.inf:
-                snapshot_time, reason = t_stop, "time"
-            if interruption.requested:
-                reason = "interrupted"
+            if reason in ("time", "no_events") and math.isinf(engine.next_event_time()):
+                # nothing will ever move again: the run is over
+                reason = "no_events"
+                if stop.time is not None:
+                    snapshot_time = max(stop.time, engine.time)
+            elif interruption.requested:
+                reason = interruption.reason
             elif reason == "predicate" or (resting is not None and resting(engine)):
                 reason = "at_rest"  # checked between chunks and at every snapshot
+            elif budget() == 0.0:
+                reason = "wall_seconds"  # also when snapshots come faster than chunks
             last_time = engine.time if snapshot_time is None else snapshot_time
             last = {"collisions": stop.collisions is not None
                     and engine.collisions >= stop.collisions,
@@ -178,31 +231,49 @@ def _advance(engine, cfg, writer, last_time, interruption):
         bar.close()
 
 
-def _writer(path, engine, cfg, mode="w"):
-    """The run file's writer, or :class:`RunFileError` when the file cannot be made."""
+def _writer(path, engine, cfg, overrides=(), mode="w-", observers=None):
+    """The run file's writer, or :class:`RunFileError` when the file cannot be made.
+    ``observers``: made for ``engine`` as it starts, by default now."""
+    if observers is None:
+        observers = observers_from_config(cfg, engine)
     try:
-        return RunWriter(path, engine, parameters(cfg), mode=mode,
-                         observers=observers_from_config(cfg, engine))
+        return RunWriter(path, engine, parameters(cfg, overrides), mode=mode,
+                         observers=observers)
     except OSError as error:
         raise RunFileError(f"cannot write the run file {path}: "
                            f"{error.strerror or error}") from error
 
 
-def _record(writer, work):
-    """Run ``work()`` (which returns the stop reason) and record how the run ended — its
-    stop reason or its error — in the file, which is closed on every path. A failed write
-    (a full disk) becomes :class:`RunFileError`; the file keeps what its last flush wrote."""
+def _record(writer, engine, work):
+    """Run ``work(interruption)`` (which returns the stop reason) under an
+    :class:`Interruption` and record how the run ended — its stop reason, its breakdown or
+    its error — in the file, which is closed on every path. A failed write (a full disk)
+    becomes :class:`RunFileError`; the file keeps what its last flush wrote. A breakdown of
+    the physics (:class:`PhysicsBreakdown`) is recorded with a final snapshot of the state
+    where it happened, then raised."""
+    with Interruption() as interruption:
+        _record_interruptible(writer, engine, lambda: work(interruption))
+
+
+def _record_interruptible(writer, engine, work):
     try:
         writer.finish(work())
     except DiskFullError as error:
-        writer.give_up(f"error: disk full: {error.strerror}")
+        full = "disk full" if error.errno == errno.ENOSPC else "file size limit"
+        writer.give_up(f"error: {full}: {error.strerror}")
+        remedy = ("free some room" if error.errno == errno.ENOSPC
+                  else "raise the file size limit (ulimit -f)")
         raise RunFileError(f"stopped before writing to {writer.path}: {error.strerror}. The "
-                           f"file holds every snapshot up to its last flush; free some room and "
+                           f"file holds every snapshot up to its last flush; {remedy} and "
                            f"resume from its last checkpoint") from error
     except OSError as error:
-        writer.abandon()
-        reason = " ".join(str(error).split())  # HDF5's messages span lines
+        writer.abandon(error)
+        reason = hdf5_reason(error)
         raise RunFileError(f"writing the run file {writer.path} failed: {reason}") from error
+    except PhysicsBreakdown as error:
+        writer.snapshot(engine, checkpoint=True)
+        writer.finish(error.stop_reason, message=str(error))
+        raise
     except BaseException as error:
         writer.finish(f"error: {type(error).__name__}: {error}")
         raise
@@ -210,45 +281,285 @@ def _record(writer, work):
         writer.abandon()
 
 
-def run(cfg, output_dir="."):
-    """Run the scene of ``cfg`` into ``output_dir/cfg.output.file``; returns the path."""
-    if not OmegaConf.is_config(cfg):
-        cfg = OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
-    validate(cfg)
-    engine = build_engine(cfg)
-    path = Path(output_dir) / cfg.output.file
-    writer = _writer(path, engine, cfg)
+def _as_config(cfg):
+    if OmegaConf.is_config(cfg):
+        return cfg
+    return OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
 
-    def from_the_start():
-        writer.snapshot(engine, 0.0)
-        return advance(engine, cfg, writer, 0.0)
 
-    _record(writer, from_the_start)
+def _flat(cfg):
+    """{dotted key: value} of every leaf of a config (lists stay whole)."""
+    def walk(node, prefix):
+        for key, value in node.items():
+            if isinstance(value, dict) and value:
+                yield from walk(value, f"{prefix}{key}.")
+            else:
+                yield f"{prefix}{key}", value
+    return dict(walk(OmegaConf.to_container(cfg, resolve=True), ""))
+
+
+def differences(stored, cfg, ignore=()):
+    """{key: (value in ``stored``, value in ``cfg``)} for every key in which two configs
+    differ, but those of ``ignore``."""
+    a, b = _flat(stored), _flat(cfg)
+    return {key: (a.get(key), b.get(key)) for key in sorted({*a, *b})
+            if key not in ignore and a.get(key) != b.get(key)}
+
+
+def describe_differences(differ):
+    """``"key: a there, b here; …"`` of :func:`differences`."""
+    return "; ".join(f"{key}: {a!r} there, {b!r} here" for key, (a, b) in differ.items())
+
+
+def _existing_file(path, key):
+    """``path`` as a run file's path: a folder or a missing file is a :class:`ConfigError`."""
+    if not str(path).strip():
+        raise ConfigError(key, str(path), "the path of a run file")
+    path = Path(path)
+    if path.is_dir():
+        inside = path / "run.h5"
+        hint = f" (the run file there is {inside})" if inside.is_file() else ""
+        raise ConfigError(key, str(path), f"a run file, not a folder{hint}")
+    if not path.exists():
+        raise ConfigError(key, str(path), "an existing run file: there is no such file")
     return path
 
 
-def resume(path):
-    """Continue the run file at ``path`` from its latest checkpoint, appending to it."""
-    path = Path(path)
-    with h5py.File(path, "r") as f:
-        config_yaml = f["parameters"].attrs["config"]
-        reason = str(f["parameters"].attrs["stop_reason"])
-        checkpointed = "checkpoint" in f and "latest" in f["checkpoint"].attrs
-    if reason in FINISHED:
-        return path  # nothing left to do: the run ended by one of its stop conditions
-    cfg = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(config_yaml))
-    if not checkpointed:  # stopped before its first checkpoint was complete: start again
-        cfg.output.file = path.name
-        return run(cfg, path.parent)
+def stored_config(path, key="resume"):
+    """The resolved config and stop reason recorded in the run file ``path``; a file that is
+    missing, a folder, not a run file or damaged is a :class:`ConfigError` on ``key``."""
+    path = _existing_file(path, key)
+    try:
+        with open_run_file(path) as f:
+            attrs = f["parameters"].attrs
+            text, reason = str(attrs["config"]), str(attrs["stop_reason"])
+        stored = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(text))
+    except UnreadableRunFile as error:
+        raise ConfigError(key, str(path), f"a readable run file: {error}") from error
+    except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
+        raise ConfigError(key, str(path), f"a run file with its config intact: "
+                          f"{type(error).__name__}: {error}") from error
+    return stored, reason
+
+
+def _check_consistent(path, cfg, key="resume"):
+    """Refuse (:class:`ConfigError` on ``key``) a run file whose disks, box or checkpoint do
+    not have the sizes its stored config ``cfg`` implies (a config edited in the file)."""
+    n, n_key = resources.disk_count(cfg)
+    periodic = cfg.box.boundary == "periodic"
+    try:
+        with open_run_file(path) as f:
+            disks = f["particles/disks"]
+            found = {"disks": disks["radius"].shape[0],
+                     "box": [float(x) for x in disks["box/edges"][()]],
+                     "boundary": [b.decode() for b in disks["box"].attrs["boundary"]]}
+            root = f.get("checkpoint")
+            if root is not None and "latest" in root.attrs:
+                found["checkpointed disks"] = root[root.attrs["latest"]]["disks/table"].shape[0]
+    except (UnreadableRunFile, KeyError, OSError, RuntimeError) as error:
+        raise ConfigError(key, str(path), f"a readable run file: "
+                          f"{' '.join(str(error).split())}") from error
+    wanted = {"disks": n, "box": [float(x) for x in cfg.box.size],
+              "boundary": ["periodic" if periodic else "none"] * 2,
+              "checkpointed disks": n}
+    wrong = [f"{name} {found[name]} in the file, {wanted[name]} by its config"
+             for name in found if found[name] != wanted[name]]
+    if wrong:
+        raise ConfigError(key, str(path), f"a run file whose data match its stored config "
+                          f"(edited since the run?): {'; '.join(wrong)}")
+
+
+def resumable(path, overrides=()):
+    """The config ``resume(path, overrides)`` would run, validated, after every check that
+    resume makes before it writes (:class:`ConfigError`)."""
+    path = _existing_file(path, "resume")
+    with _locked(path, "resume"):
+        stored, _ = stored_config(path)
+        _check_consistent(path, stored)
+    cfg = _apply(stored, list(overrides))
     validate(cfg)
+    return cfg
+
+
+@contextmanager
+def _locked(path, key):
+    """Hold the lock of the run file ``path`` (:class:`sim.run_folder.RunLock`): another
+    process's lock is a :class:`ConfigError` on ``key``, a folder where no lock file can
+    be made a :class:`RunFileError`."""
+    lock = RunLock(path)
+    try:
+        lock.__enter__()
+    except FolderBusyError as error:
+        holder = f"process {error.pid}" if error.pid else "another process"
+        what = "run file" if key == "resume" else "folder"
+        raise ConfigError(key, str(path if key == "resume" else path.parent),
+                          f"a {what} that no other run is using: {holder} is writing "
+                          f"{path}; wait for it to end, or choose another") from None
+    except OSError as error:
+        raise RunFileError(f"cannot write the run file {path}: "
+                           f"{error.strerror or error}") from error
+    try:
+        yield
+    finally:
+        lock.__exit__()
+
+
+def run(cfg, output_dir=".", overrides=(), folder_key="output_dir"):
+    """Run the scene of ``cfg`` into ``output_dir/cfg.output.file``; returns the path.
+
+    The folder decides, under the run file's lock: no run file there, the run is made;
+    the same config's run (all keys but :data:`COSMETIC`) complete, it is returned as it is;
+    cut short, it is resumed; another config's run or a file that is not a run file,
+    :class:`ConfigError` on ``folder_key`` (named in the message). ``overrides``: the
+    command-line overrides that made ``cfg``, recorded in the file.
+    """
+    started = wallclock.perf_counter()
+    cfg = _as_config(cfg)
+    validate(cfg)
+    path = Path(output_dir) / cfg.output.file
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise RunFileError(f"cannot write the run file {path}: "
+                           f"{error.strerror or error}") from error
+    with _locked(path, folder_key):
+        if path.exists():
+            return _again(path, cfg, folder_key, started)
+        resources.check(cfg, path.parent)
+        engine = build_engine(cfg)
+        check_reachable(cfg, engine)
+        return _new_run(path, engine, cfg, overrides, started)
+
+
+def _new_run(path, engine, cfg, overrides, started):
+    """Write the run file under its hidden name until the first snapshot and checkpoint are
+    on disk, then put it in place (:func:`sim.run_folder.publish`) and run on."""
+    part = part_path(path)
+    published = []
+    try:
+        writer = _writer(part, engine, cfg, overrides)
+        writer.path = path  # its name in messages; the file is ``part`` until published
+
+        def from_the_start(interruption):
+            writer.snapshot(engine, 0.0, checkpoint=True)
+            publish(part, path)
+            published.append(path)
+            return advance(engine, cfg, writer, 0.0, started, interruption)
+
+        _record(writer, engine, from_the_start)
+    except RunFileError as error:
+        if published:
+            raise
+        cause = error.__cause__ or error
+        raise RunFileError(f"cannot write the run file {path}: "
+                           f"{getattr(cause, 'strerror', None) or cause}; nothing was "
+                           f"written") from error
+    finally:
+        part.unlink(missing_ok=True)
+    return path
+
+
+def _again(path, cfg, key, started):
+    """The run file of ``cfg`` is there already: return it complete, resume it, or refuse."""
+    try:
+        stored, reason = stored_config(path, key)
+    except ConfigError as error:
+        raise ConfigError(key, str(path.parent), f"a folder without a foreign file at "
+                          f"{path.name}: {error.allowed}") from error
+    differ = differences(stored, cfg, ignore=COSMETIC)
+    if differ:
+        raise ConfigError(key, str(path.parent),
+                          f"a folder without another config's run; its {path.name} differs "
+                          f"in {describe_differences(differ)}; choose another folder")
+    _check_consistent(path, stored, key)
+    if reason in FINISHED:
+        log.info("%s is complete (stopped by %s); not run again", path, reason)
+        return path
+    return _resume_locked(path, stored, reason, _cosmetic(cfg), started)
+
+
+def _cosmetic(cfg):
+    """The :data:`COSMETIC` keys of ``cfg`` as overrides."""
+    def text(value):
+        return "null" if value is None else str(value).lower() if isinstance(value, bool) \
+            else str(value)
+    return [f"{key}={text(OmegaConf.select(cfg, key))}" for key in COSMETIC]
+
+
+def resume(path, overrides=()):
+    """Continue the run file at ``path`` from its latest checkpoint, appending to it.
+
+    ``overrides`` (``"key=value"`` strings) may change the keys of :data:`RESUMABLE`: a
+    complete run continues to new stop conditions; the file's config records them. A path
+    that is no run file, a run another process is writing, a checkpoint that does not match
+    its config or stop conditions met already are a :class:`ConfigError` on ``resume`` (or
+    the key), and leave the file as it was."""
+    started = wallclock.perf_counter()
+    path = _existing_file(path, "resume")
+    with _locked(path, "resume"):
+        stored, reason = stored_config(path)
+        _check_consistent(path, stored)
+        return _resume_locked(path, stored, reason, list(overrides), started)
+
+
+def _apply(stored, overrides):
+    """``stored`` with ``overrides`` applied; keys outside :data:`RESUMABLE` are refused."""
+    keys = [item.partition("=")[0].lstrip("+~") for item in overrides]
+    fixed = [key for key in keys if key not in RESUMABLE]
+    if fixed:
+        raise ConfigError(fixed[0], OmegaConf.select(stored, fixed[0], default=None),
+                          f"unchanged on resume (it would change what the run file "
+                          f"holds); a resume may change {', '.join(RESUMABLE)}")
+    try:
+        cfg = OmegaConf.merge(stored, OmegaConf.from_dotlist(list(overrides)))
+    except ValidationError as error:
+        raise ConfigError(error.full_key, error.value, str(error.msg).splitlines()[0]) \
+            from error
+    if any(k == "output.every_time" for k in keys) and "output.every_collisions" not in keys:
+        cfg.output.every_collisions = None  # a cadence in time replaces one in collisions
+    if any(k == "output.every_collisions" for k in keys) and "output.every_time" not in keys:
+        cfg.output.every_time = None
+    return cfg
+
+
+def _resume_locked(path, stored, reason, overrides, started):
+    cfg = _apply(stored, overrides)
+    validate(cfg)
+    differ = differences(stored, cfg)
+    changed = [item for item in overrides if item.partition("=")[0].lstrip("+~") in differ]
+    with h5py.File(path, "r") as f:
+        checkpointed = "checkpoint" in f and "latest" in f["checkpoint"].attrs
+        made_by = yaml.safe_load(str(f["parameters"].attrs.get("overrides", "[]"))) or []
+    if not checkpointed:  # a file of a run that never reached its first checkpoint
+        path.unlink()
+        return _new_run(path, build_engine(cfg), cfg, made_by, started)
+    if reason in FINISHED and not changed:
+        log.info("%s is complete (stopped by %s); nothing to resume", path, reason)
+        return path
     engine = build_engine(cfg)
-    writer = _writer(path, engine, cfg, mode="r+")
-
-    def from_the_checkpoint():
-        state, last_time, snapshots = read_checkpoint(writer.file)
+    observers = observers_from_config(cfg, engine)  # they remember the start of the run
+    try:  # read-only: a refusal leaves the file as it was
+        with h5py.File(path, "r") as f:
+            state, last_time, snapshots = read_checkpoint(f)
         engine.load_state_dict(state)
-        writer.truncate(snapshots, engine.events)
-        return advance(engine, cfg, writer, last_time)
+    except UnreadableRunFile as error:  # both checkpoints damaged
+        raise ConfigError("resume", str(path), "a run file with an intact checkpoint; "
+                          + str(error).partition(": ")[2]) from error
+    except (ValueError, KeyError, OSError) as error:
+        raise ConfigError("resume", str(path), f"a checkpoint that matches its config: "
+                          f"{' '.join(str(error).split())}") from error
+    met = already_met(engine, cfg)
+    if met is not None:
+        if changed:
+            raise ConfigError(*met)
+        log.info("%s is complete; nothing to resume", path)
+        return path
+    writer = _writer(path, engine, cfg, mode="r+", observers=observers)
 
-    _record(writer, from_the_checkpoint)
+    def from_the_checkpoint(interruption):
+        writer.truncate(snapshots, engine.events)
+        writer.record_resume(OmegaConf.to_yaml(cfg, resolve=True), snapshots, changed)
+        return advance(engine, cfg, writer, last_time, started, interruption)
+
+    _record(writer, engine, from_the_checkpoint)
     return path

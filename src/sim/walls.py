@@ -44,32 +44,40 @@ _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX_2 = np.uint64(0x94D049BB133111EB)
 
 
+#: Wall names by number.
+NAMES = ("left", "right", "bottom", "top")
+
+
 def wall_motion(walls):
     """float64[4, 3] of (U, A, ω) per wall for the compiled loop, or None when no wall moves.
 
-    ``walls`` maps wall numbers to dicts with the keys speed, amplitude, frequency (angular).
+    ``walls`` maps wall numbers to dicts with the keys speed, amplitude, frequency (angular):
+    all finite, amplitude and frequency ≥ 0.
     """
     motion = np.zeros((4, 3))
     for wall, spec in walls.items():
         motion[wall] = (spec.get("speed", 0.0), spec.get("amplitude", 0.0),
                         spec.get("frequency", 0.0))
-    if not np.all(np.isfinite(motion)):
-        raise ValueError(f"wall speed, amplitude and frequency must be finite, got {walls}")
-    if np.any(motion[:, 1] < 0.0) or np.any(motion[:, 2] < 0.0):
-        raise ValueError("wall amplitude and frequency must be ≥ 0")
+        speed, amplitude, frequency = motion[wall]
+        if not (math.isfinite(speed) and 0.0 <= amplitude < INF and 0.0 <= frequency < INF):
+            raise ValueError(f"{NAMES[wall]} wall: speed {speed}, amplitude {amplitude} and "
+                             f"frequency {frequency} must be finite, amplitude and frequency ≥ 0")
     motion[motion[:, 2] == 0.0, 1] = 0.0  # no frequency, no oscillation
     return motion if np.any(motion[:, :2]) else None
 
 
 def wall_temperature(walls):
-    """float64[4] of wall temperatures (NaN: not thermal), or None when no wall is thermal."""
+    """float64[4] of wall temperatures (NaN: not thermal), or None when no wall is thermal.
+    ``walls`` maps wall numbers to dicts whose key temperature, when given, is finite and > 0."""
     temperature = np.full(4, np.nan)
     for wall, spec in walls.items():
         if spec.get("temperature") is not None:
-            if not spec["temperature"] > 0.0:
-                raise ValueError(f"a wall temperature must be > 0, got {spec['temperature']}")
-            temperature[wall] = spec["temperature"]
-    return temperature if np.any(np.isfinite(temperature)) else None
+            t_wall = float(spec["temperature"])
+            if not 0.0 < t_wall < INF:
+                raise ValueError(f"{NAMES[wall]} wall: temperature {t_wall} must be finite and "
+                                 f"> 0")
+            temperature[wall] = t_wall
+    return temperature if not np.all(np.isnan(temperature)) else None
 
 
 @njit(cache=True, inline="always")

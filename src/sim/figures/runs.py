@@ -10,14 +10,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-import h5py
 from hydra import compose, initialize_config_dir
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import OmegaConf
 
-from sim.__main__ import CONF_DIR
+from sim.cli import CONF_DIR
 from sim.config import register
-from sim.runner import FINISHED, run
+from sim.runner import run
 
 register()
 
@@ -27,27 +26,17 @@ def compose_config(overrides):
         return compose("config", overrides=list(overrides))
 
 
-def _finished(path):
-    try:
-        with h5py.File(path, "r") as f:
-            return str(f["parameters"].attrs["stop_reason"]) in FINISHED
-    except (OSError, KeyError):
-        return False
-
-
 def _digest(text):
     return hashlib.sha1(text.encode()).hexdigest()[:10]
 
 
 def ensure_run(label, overrides, root):
-    """The run file of ``overrides`` under ``root``, simulated only if not there yet."""
+    """The run file of ``overrides`` under ``root``, simulated only if not there yet (a run
+    cut short there is resumed, :func:`sim.runner.run`)."""
     cfg = compose_config([*overrides, "output.progress=false"])
     folder = Path(root) / f"{label}-{_digest(OmegaConf.to_yaml(cfg, resolve=True))}"
-    path = folder / cfg.output.file
-    if not _finished(path):
-        folder.mkdir(parents=True, exist_ok=True)
-        run(cfg, folder)
-    return path
+    folder.mkdir(parents=True, exist_ok=True)
+    return run(cfg, folder)
 
 
 def _first_value(override):

@@ -1,0 +1,109 @@
+"""One run file, one process: a folder of its own for every run, a lock held for the run's
+life, and a new run file that appears whole or not at all.
+
+* :func:`new_folder` makes a folder that no other process has: ``base``, else ``base-2``,
+  ``base-3``, … (``mkdir`` is atomic, so two runs started in the same second get two folders).
+* :class:`RunLock` is an exclusive ``flock`` on the hidden file ``.run.h5.lock`` beside the
+  run file, taken before the run file is read or written and released when the run ends; the
+  kernel releases it when the process dies, so a killed run never leaves a stale lock. A
+  second process that asks for it is refused at once, naming the holder's pid.
+* A new run file is written under the hidden name ``.run.h5.part`` (:func:`part_path`) and
+  linked into place once its header, first snapshot and first checkpoint are on disk
+  (:func:`publish`): a run killed at any moment leaves a readable run file or none.
+"""
+
+import errno
+import fcntl
+import os
+from pathlib import Path
+
+
+class FolderBusyError(RuntimeError):
+    """Another live process holds the lock of this run file."""
+
+    def __init__(self, path, pid):
+        self.path, self.pid = path, pid
+        holder = f"process {pid}" if pid else "another process"
+        super().__init__(f"{path} is being written by {holder}, a run still going; wait for "
+                         f"it to end or choose another folder")
+
+
+def new_folder(base):
+    """Create and return a folder that did not exist: ``base``, else ``base-2``, … ."""
+    base = Path(base)
+    base.parent.mkdir(parents=True, exist_ok=True)
+    for k in range(1, 10_000):
+        folder = base if k == 1 else base.with_name(f"{base.name}-{k}")
+        try:
+            folder.mkdir()
+            return folder
+        except FileExistsError:
+            continue
+    raise FileExistsError(errno.EEXIST, f"no free folder name next to {base}")
+
+
+def lock_path(path):
+    return Path(path).with_name(f".{Path(path).name}.lock")
+
+
+def part_path(path):
+    """Where a new run file is written until :func:`publish` puts it in place."""
+    return Path(path).with_name(f".{Path(path).name}.part")
+
+
+class RunLock:
+    """Exclusive lock on the run file ``path`` for this process (see the module docstring);
+    a context manager. :class:`FolderBusyError` when another process holds it."""
+
+    def __init__(self, path):
+        self.path = Path(path)
+        self.file = lock_path(path)
+        self._fd = None
+
+    def __enter__(self):
+        while True:
+            fd = os.open(self.file, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 32).decode(errors="replace").strip()
+                os.close(fd)
+                raise FolderBusyError(self.path, holder) from None
+            # a releasing process unlinks the lock file: the one locked must still be there
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.file))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        os.write(fd, str(os.getpid()).encode())
+        self._fd = fd
+        # what a run killed before publishing left behind; only the lock's holder writes it
+        part_path(self.path).unlink(missing_ok=True)
+        return self
+
+    def __exit__(self, *exc):
+        self.file.unlink(missing_ok=True)
+        os.close(self._fd)
+        self._fd = None
+        return False
+
+
+def publish(part, path):
+    """Put the finished header ``part`` in place as ``path`` (never over an existing file:
+    :class:`FileExistsError`)."""
+    try:
+        os.link(part, path)
+    except FileExistsError:
+        raise
+    except OSError as error:
+        if error.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV, errno.EMLINK):
+            raise
+        # a file system without hard links: the lock keeps other runs away from ``path``
+        if Path(path).exists():
+            raise FileExistsError(errno.EEXIST, f"{path} exists") from error
+        os.rename(part, path)
+        return
+    os.unlink(part)

@@ -1,0 +1,319 @@
+"""What the engine refuses and where it stops: checked input, cells that cannot overflow, the
+stall guard, errors of physics as one family, the piston guard after every chunk, and chunks
+sized for a wall-clock budget."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import assert_no_overlap, gas
+from sim.engine import (
+    TIMED_FIRST_CHUNK,
+    Boundary,
+    ClosedBoxError,
+    Engine,
+    InelasticCollapseError,
+    PhysicsBreakdown,
+    StalledError,
+    cell_limit,
+    first_overlap,
+    grid_cells,
+)
+from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
+
+
+def refused(match, *args, **options):
+    """The one-line ValueError that ``Engine(*args, **options)`` raises, matching ``match``."""
+    with pytest.raises(ValueError, match=match) as caught:
+        Engine(*args, **options)
+    assert "\n" not in str(caught.value)
+    return str(caught.value)
+
+
+# -- 1. the input is checked ----------------------------------------------------------------
+def brute_first_overlap(position, radius, box, periodic, tolerance=1e-9):
+    """The definition of :func:`sim.engine.first_overlap`, pair by pair."""
+    for i in range(len(radius)):
+        r = position[i] - position[:i]
+        r -= np.where(periodic, box * np.round(r / box), 0.0)
+        distance = np.hypot(r[:, 0], r[:, 1])
+        bad = np.flatnonzero(distance < (radius[i] + radius[:i]) * (1.0 - tolerance))
+        if bad.size:
+            return i, int(bad[0])
+    return None
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(2, 80), seed=st.integers(0, 10_000), periodic=st.booleans(),
+       spread=st.sampled_from([1.0, 3.0, 30.0]), size=st.floats(0.005, 0.08))
+def test_first_overlap_is_the_first_disk_that_overlaps_one_before_it(n, seed, periodic, spread,
+                                                                     size):
+    """Against all pairs, for radii spread over up to a factor 30 (several grid levels)."""
+    rng = np.random.default_rng(seed)
+    radius = size * spread ** rng.uniform(-1.0, 0.0, n)
+    box = np.array([1.0, 0.7])
+    position = rng.uniform(0.0, 1.0, (n, 2)) * box
+    if not periodic:
+        position = np.clip(position, radius[:, None], box - radius[:, None])
+    found = first_overlap(position, radius, box, (periodic, periodic))
+    expected = brute_first_overlap(position, radius, box, (periodic, periodic))
+    assert (found if found is None else found[:2]) == expected
+
+
+def test_overlapping_disks_are_refused_naming_the_first():
+    n = 30
+    radius = np.full(n, 0.02)
+    position = random_sequential(radius, seed=5)
+    position[17] = position[3] + [0.03, 0.0]  # 0.03 < 0.04 from disk 3
+    position[25] = position[4]
+    message = refused(r"^disk 17 at \[.*\] overlaps disk 3 \(distance 0\.03 < contact "
+                      r"distance 0\.04\)", position, np.zeros((n, 2)), radius)
+    assert "may touch" in message
+    # across the side of a periodic box
+    refused("disk 1 at .* overlaps disk 0", [[0.005, 0.5], [0.99, 0.5]], np.zeros((2, 2)), 0.01,
+            boundary=Boundary(periodic=(True, True)))
+    # a large disk over small ones given before it
+    small = hexagonal_lattice(200, 0.01, seed=2)
+    position = np.vstack([small, [[0.5, 0.5]]])
+    radius = np.append(np.full(200, 0.01), 0.1)
+    refused("disk 200 at .* overlaps disk", position, np.zeros((201, 2)), radius)
+    # disks placed exactly in contact stay accepted
+    r = 0.02
+    row = [[r + 2 * r * k, 0.5] for k in range(10)]
+    assert Engine(row, np.zeros((10, 2)), r).n == 10
+
+
+def test_bad_values_are_refused_naming_the_disk_or_parameter():
+    position = hexagonal_lattice(10, 0.02, seed=1)
+    velocity = np.zeros((10, 2))
+    p = position.copy()
+    p[4, 1] = np.nan
+    refused(r"disk 4 has position \[.*nan\]", p, velocity, 0.02)
+    v = velocity.copy()
+    v[6, 0] = np.inf
+    refused(r"disk 6 has velocity \[inf", position, v, 0.02)
+    for bad in (0.0, -0.02, np.nan, np.inf):
+        radius = np.full(10, 0.02)
+        radius[2] = bad
+        refused(r"disk 2 has radius .*: a radius must be finite and > 0", position, velocity,
+                radius)
+        mass = np.ones(10)
+        mass[7] = bad
+        refused(r"disk 7 has mass .*: a mass must be finite and > 0", position, velocity, 0.02,
+                mass)
+    p = position.copy()
+    p[3] = [0.01, 0.5]
+    refused(r"disk 3 at \[0\.01, 0\.5\] with radius 0\.02 pokes through a wall", p, velocity,
+            0.02)
+    for size in ((1.0, np.nan), (0.0, 1.0), (1.0, np.inf)):
+        refused("box size must be two finite sides > 0", position, velocity, 0.02,
+                boundary=Boundary(size=size))
+
+    def wall(**spec):
+        return {"walls": {"left": {"temperature": 1.0}, "top": spec}}
+
+    for t_wall in (np.inf, np.nan, 0.0, -1.0):
+        refused(r"top wall: temperature .* must be finite and > 0", position, velocity, 0.02,
+                **wall(temperature=t_wall))
+    for spec in ({"speed": np.nan}, {"speed": np.inf}, {"amplitude": -0.1, "frequency": 1.0},
+                 {"amplitude": 0.1, "frequency": np.inf}, {"amplitude": np.nan}):
+        refused("top wall: speed .* must be finite", position, velocity, 0.02, **wall(**spec))
+    refused(r"top wall: unknown keys \['temprature'\]", position, velocity, 0.02,
+            **wall(temprature=1.0))
+    for g in ([0.0, np.nan], [np.inf, 0.0]):
+        refused("gravity must be two finite numbers", position, velocity, 0.02, gravity=g)
+    for tc in (np.nan, np.inf, -1e-8):
+        refused("tc .* must be finite and ≥ 0", position, velocity, 0.02, restitution=0.9,
+                tc=tc)
+    for xi in (np.nan, 1.5, -0.1):
+        refused("restitution must lie in", position, velocity, 0.02, restitution=xi)
+        refused("wall_restitution must lie in", position, velocity, 0.02, wall_restitution=xi)
+    for seed in (-1, 2**63, 1.5, "7"):
+        refused(r"seed must be an integer in \[0, 2\*\*63 - 1\]", position, velocity, 0.02,
+                seed=seed)
+    assert Engine(position, velocity, 0.02, seed=2**63 - 1).seed == 2**63 - 1
+
+
+# -- 2. sizing that cannot overflow -----------------------------------------------------------
+def test_cell_count_is_capped_whatever_the_scale():
+    for box, width, n in (((1.0, 1.0), 1e-40, 100), ((1e30, 1e30), 1e-3, 100),
+                          ((1e300, 1.0), 1e-300, 10), ((1.0, 1.0), 0.1, 100)):
+        cells = grid_cells(np.array(box), width, cell_limit(n))
+        assert 1 <= cells[0] * cells[1] <= cell_limit(n)
+        assert np.all(np.array(box) / cells >= width)
+    assert grid_cells(np.array([1.0, 1.0]), 0.1, cell_limit(100)).tolist() == [10, 10]
+
+
+def scaled_cluster(radius, box, speed=1.0, mass=1.0, n=400, **options):
+    """n disks of ``radius`` on a lattice at φ = 0.5 in the corner (0, 0) of ``box``."""
+    unit = radius_for_packing(n, 0.5)
+    position = hexagonal_lattice(n, unit, seed=1) * (radius / unit)
+    return Engine(position, fixed_speed(n, speed, seed=2), radius, mass,
+                  boundary=Boundary(size=box), **options)
+
+
+@pytest.mark.parametrize("radius, side, speed, mass", [
+    (1e-40, 1.0, 1.0, 1.0), (1e-3, 1e30, 1.0, 1.0), (1e-52, 1e-50, 1.0, 1.0),
+    (0.014, 1.0, 1e-50, 1.0), (0.014, 1.0, 1e50, 1e-50), (0.014, 1.0, 1.0, 1e50)])
+def test_extreme_but_finite_scales_run_clean(radius, side, speed, mass):
+    """Tiny disks in a large box get a few wide cells, and each scene runs thousands of
+    collisions without overlap, its energy kept (the bound on events spent is far above the
+    ~2e5 that the slowest, a cluster spreading into its box, spends)."""
+    engine = scaled_cluster(radius, (side, side), speed, mass)
+    assert engine.grid[0] * engine.grid[1] <= cell_limit(engine.n)
+    energy = engine.kinetic_energy()
+    assert engine.run(collisions=3000, until=lambda e: e.steps > 10**6) == "collisions"
+    assert engine.kinetic_energy() == pytest.approx(energy, rel=1e-12)
+    assert_no_overlap(engine)
+
+
+def test_disks_slow_against_their_box_do_not_hang_the_queue():
+    """Predictions 1e50 time units ahead fit the queue, also when every first prediction is
+    made before the first event (no contact at t = 0)."""
+    n = 100
+    radius = radius_for_packing(n, 0.2)
+    engine = Engine(random_sequential(np.full(n, radius), seed=3), fixed_speed(n, 1e-50, seed=4),
+                    radius)
+    assert engine.run(events=2000) == "events"
+    assert 1e48 < engine.time < 1e52
+    assert_no_overlap(engine)
+
+
+@pytest.mark.parametrize("scene, match", [
+    ({"velocity": 1e200}, "the speed of disk 0 is 1e.200: it must lie in"),
+    ({"velocity": 1e-70}, "the speed of disk 0 is 1e-70"),
+    ({"mass": 1e200}, "the mass of disk 0 is 1e.200"),
+    ({"side": 1e300}, "the box side along x is 1e.300"),
+    ({"gravity": [0.0, -1e200]}, r"√\(\|g\| L\).* is 1e\+100"),
+    ({"walls": {"left": {"temperature": 1e300}}}, r"√\(T_w / m\) of the left wall"),
+    ({"walls": {"top": {"amplitude": 0.01, "frequency": 1e100}}}, "A ω of the top wall"),
+    ({"radius": 1e-40}, "radius of disk 0 is 1e-40, less than 2..-40 of the far edge"),
+    ({"radius": 1e-3, "side": 1e30, "periodic": True}, "far edge of the disks .1e.30"),
+])
+def test_scenes_float64_cannot_hold_are_refused_naming_the_parameter(scene, match):
+    side = scene.get("side", 1.0)
+    speed = scene.get("velocity", 1.0)
+    refused(match, [[0.5, 0.5], [0.7, 0.5]], [[speed, 0.0], [0.0, 0.0]],
+            scene.get("radius", 0.05), scene.get("mass", 1.0),
+            boundary=Boundary(size=(side, side), periodic=(scene.get("periodic", False),) * 2),
+            gravity=scene.get("gravity"), walls=scene.get("walls"))
+
+
+# -- 3. the stall guard -----------------------------------------------------------------------
+def touching_ring(n=20, radius=0.01, **options):
+    """n disks touching all round a periodic box 2 n R wide; the first moves along the row."""
+    x = radius + 2.0 * radius * np.arange(n)
+    velocity = np.zeros((n, 2))
+    velocity[0, 0] = 1.0
+    return Engine(np.stack([x, np.full(n, 0.5)], axis=1), velocity, radius,
+                  boundary=Boundary(size=(2 * n * radius, 1.0), periodic=(True, True)),
+                  **options)
+
+
+@pytest.mark.parametrize("options", [{}, {"restitution": 0.5, "tc": 1e-6}])
+@pytest.mark.parametrize("chunk_events", [200_000, 100])
+def test_a_chain_creeping_round_a_periodic_box_is_a_stall(options, chunk_events):
+    """Momentum runs round the ring through contacts a few ulps apart in time: caught within
+    the guard's 16 N + 1000 events, also when they span many chunks."""
+    engine = touching_ring(**options)
+    with pytest.raises(StalledError, match="TC model") as caught:
+        engine.run(events=10**7, chunk_events=chunk_events)
+    assert "\n" not in str(caught.value)
+    assert engine.steps <= 16 * engine.n + 1001
+    assert engine.time < 1e-12
+
+
+def test_an_inelastic_chain_without_tc_collapses():
+    with pytest.raises(InelasticCollapseError, match="TC model"):
+        touching_ring(restitution=0.5).run(events=10**7)
+
+
+def test_stall_interval_follows_the_fastest_speed_the_scene_sets():
+    """stall_dt = 2⁻⁴⁴ D / v: D the far edge of the disks (1 here), v the initial rms speed,
+    √(|g| L), |U| + A ω or √(T_w/m), whichever is fastest."""
+    def stall_dt(velocity=(0.3, 0.4), **options):
+        return Engine([[0.95, 0.5]], [velocity], 0.05, **options).stall_dt
+
+    assert stall_dt() == 2.0**-44 / 0.5
+    assert stall_dt(velocity=(0.0, 0.0)) == 2.0**-44
+    assert stall_dt(gravity=[0.0, -4.0]) == 2.0**-44 / 2.0
+    assert stall_dt(walls={"top": {"speed": -3.0}}) == 2.0**-44 / 3.0
+    assert stall_dt(walls={"top": {"amplitude": 0.01, "frequency": 500.0}}) == pytest.approx(
+        2.0**-44 / 5.0, rel=1e-15)
+    assert stall_dt(walls={"top": {"temperature": 16.0}}) == 2.0**-44 / 4.0
+    # disks in a corner of a huge box: the ulps of their coordinates, not of the box side
+    assert stall_dt(boundary=Boundary(size=(1e30, 1e30))) == 2.0**-44 / 0.5
+
+
+# -- 4. errors of physics are one family ------------------------------------------------------
+def test_errors_of_physics_share_a_base_and_name_their_stop_reason():
+    reasons = {StalledError: "stalled", InelasticCollapseError: "inelastic_collapse",
+               ClosedBoxError: "closed_box"}
+    for kind, reason in reasons.items():
+        assert issubclass(kind, PhysicsBreakdown) and issubclass(kind, RuntimeError)
+        assert kind.stop_reason == reason
+    position = np.array([[0.4, 0.5], [0.5, 0.5], [0.6, 0.5]])
+    velocity = [[1.0, 0.0], [0.0, 0.0], [-0.7, 0.0]]
+    with pytest.raises(PhysicsBreakdown) as caught:
+        Engine(position, velocity, 0.01, restitution=0.05).run(collisions=10**6)
+    assert caught.value.stop_reason == "inelastic_collapse"
+    assert "\n" not in str(caught.value) and "tc.time" in str(caught.value)
+    lone = Engine([[0.5, 0.5]], [[0.0, 0.0]], 0.05, walls={"right": {"speed": -0.1}})
+    with pytest.raises(PhysicsBreakdown) as caught:
+        lone.run(time=10.0)
+    assert caught.value.stop_reason == "closed_box"
+    assert "\n" not in str(caught.value) and "stop.time" in str(caught.value)
+
+
+# -- 5. the piston guard runs after every chunk -----------------------------------------------
+def test_a_jammed_piston_is_caught_when_the_caller_stops_every_few_collisions():
+    """Snapshots every 200 collisions end every call before its chunk: the guard still runs
+    after each, and the jam is reported before the walls close."""
+    n = 50
+    radius = radius_for_packing(n, 0.05)
+    engine = Engine(random_sequential(np.full(n, radius), seed=1), fixed_speed(n, 1.0, seed=2),
+                    radius, walls={"right": {"speed": -0.2}})
+    with pytest.raises(ClosedBoxError, match="jammed"):
+        for _ in range(100_000):
+            engine.run(collisions=engine.collisions + 200)
+    assert engine.time < engine.closing_time
+
+
+# -- 6. chunks sized for the wall-clock budget ------------------------------------------------
+def test_an_exhausted_budget_returns_after_one_small_chunk():
+    engine = gas(2000, 0.5, seed=7)
+    assert engine.run(wall_seconds=0.0, collisions=10**12) == "wall_seconds"
+    assert 0 < engine.steps <= TIMED_FIRST_CHUNK
+
+
+def test_chunks_sized_by_the_clock_change_no_bits():
+    """One call, a budget that sizes chunks from the measured rate, and many short calls all
+    end in the same state."""
+    engines = [gas(500, 0.5, (True, False), seed=29, restitution=0.9, tc=1e-6) for _ in range(3)]
+    engines[0].run(collisions=60_000)
+    engines[1].run(collisions=60_000, wall_seconds=1e9)
+    while engines[2].collisions < 60_000:
+        engines[2].run(collisions=min(engines[2].collisions + 7_000, 60_000), wall_seconds=1e9,
+                       chunk_events=5_000)
+    for engine in engines[1:]:
+        np.testing.assert_array_equal(engine.positions(), engines[0].positions())
+        np.testing.assert_array_equal(engine.velocities(), engines[0].velocities())
+        assert engine.time == engines[0].time
+
+
+# -- a checkpoint of another scene ------------------------------------------------------------
+def test_a_checkpoint_of_another_scene_is_refused_before_anything_changes():
+    """What resume loads must be this scene's: other disk counts, or arrays this engine does
+    not keep, are refused, and the engine's own state is left as it was."""
+    engine = gas(100, 0.3, seed=1)
+    engine.run(collisions=500)
+    before = {key: np.array(value) for key, value in engine.state_dict().items()}
+    larger = gas(120, 0.3, seed=1)
+    with pytest.raises(ValueError, match="disks/table has shape"):
+        engine.load_state_dict(larger.state_dict())
+    logging = gas(100, 0.3, seed=1, pressure_tensor=True)
+    with pytest.raises(ValueError, match="unknown \\['virial_tensor'\\]"):
+        engine.load_state_dict(logging.state_dict())
+    for key, value in engine.state_dict().items():
+        np.testing.assert_array_equal(value, before[key], err_msg=key)

@@ -1,0 +1,874 @@
+"""Hostile cases: what a careless, unlucky or malicious user does to ``python -m sim``.
+
+Every case asserts the documented outcome (``sim/cli.py``: exit status 0, 1, 2, 3, 130
+or 143), that stderr is one line naming the key, path or cause and never a traceback, that a
+refusal (exit 2) leaves nothing behind anywhere under the test's folder (hidden files and
+empty folders included) and that every file there before the case is unchanged (sha256).
+
+Refusals made before Hydra starts run in-process (``sim.cli.main``); whatever runs Hydra,
+the engine, signals or several processes runs as real subprocesses, each with a generous hang
+guard (``timeout=``). No assertion depends on elapsed time.
+"""
+
+import hashlib
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from sim import runner
+from sim.inspect import summary
+
+PY = sys.executable
+HANG_GUARD = 300  # seconds; a guard against hangs, never a measure of speed
+QUIET = "output.progress=false"
+
+#: a run that would go on for hours: it is stopped by a signal or a kill
+FOREVER = ["disks.n=2000", "stop.collisions=100000000", "output.every_collisions=20000"]
+#: a tiny run whose file the resume and folder cases start from
+SMALL = ["disks.n=200", "stop.collisions=2000"]
+
+
+# ---------------------------------------------------------------------------------------
+# helpers
+
+
+def tree(root):
+    """{relative path: sha256 of a file, or "dir"} of everything under ``root``, hidden
+    entries included."""
+    root = Path(root)
+    out = {}
+    for folder, dirs, files in os.walk(root):
+        for name in dirs:
+            out[str((Path(folder) / name).relative_to(root)) + "/"] = "dir"
+        for name in files:
+            path = Path(folder) / name
+            digest = hashlib.sha256()
+            with open(path, "rb") as handle:
+                for block in iter(lambda: handle.read(1 << 20), b""):
+                    digest.update(block)
+            out[str(path.relative_to(root))] = digest.hexdigest()
+    return out
+
+
+def lines_of(text):
+    return [line for line in (text or "").splitlines() if line.strip()]
+
+
+@dataclass
+class Result:
+    code: object
+    out: str
+    err: str
+
+
+def check(result, status, names=(), before=None, after=None, nothing_new=False,
+          any_of=()):
+    """Every problem of ``result`` against the expectations, as one assertion: exit status,
+    one stderr line naming each of ``names`` (and one of ``any_of``), no traceback; with
+    ``before``/``after`` trees, files unchanged and (``nothing_new``) no new entry."""
+    problems = []
+    err_lines = lines_of(result.err)
+    if result.code != status:
+        problems.append(f"exit status {result.code!r}, expected {status}")
+    if "Traceback" in (result.err or ""):
+        problems.append("stderr has a Traceback")
+    if status == 0:
+        if len(err_lines) > 1:
+            problems.append(f"stderr has {len(err_lines)} lines, expected at most one")
+    elif len(err_lines) != 1:
+        problems.append(f"stderr has {len(err_lines)} lines, expected exactly one")
+    line = err_lines[0] if err_lines else ""
+    for name in names:
+        if name not in line:
+            problems.append(f"stderr line does not name {name!r}")
+    if any_of and not any(name in line for name in any_of):
+        problems.append(f"stderr line names none of {list(any_of)}")
+    if before is not None and after is not None:
+        changed = sorted(p for p, digest in before.items() if after.get(p) != digest)
+        if changed:
+            problems.append(f"files changed or removed: {changed}")
+        if nothing_new:
+            new = sorted(set(after) - set(before))
+            if new:
+                problems.append(f"left behind: {new}")
+    assert not problems, ("; ".join(problems) + f"\n--- exit {result.code!r}\n--- stderr:\n"
+                          f"{(result.err or '')[-3000:]}\n--- stdout:\n"
+                          f"{(result.out or '')[-1500:]}")
+
+
+def sim(*args, cwd, timeout=HANG_GUARD, **options):
+    """``python -m sim`` as a subprocess (progress bar off), to completion."""
+    done = subprocess.run([PY, "-m", "sim", QUIET, *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=timeout, **options)
+    return Result(done.returncode, done.stdout, done.stderr)
+
+
+def start(*args, cwd, **options):
+    return subprocess.Popen([PY, "-m", "sim", QUIET, *args], cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **options)
+
+
+def finish(process):
+    out, err = process.communicate(timeout=HANG_GUARD)
+    return Result(process.returncode, out, err)
+
+
+def wait_for(path, process, poll=0.01):
+    """Wait until ``path`` exists or ``process`` has ended (hang guard: HANG_GUARD)."""
+    deadline = time.monotonic() + HANG_GUARD
+    while not Path(path).exists() and process.poll() is None:
+        if time.monotonic() > deadline:
+            process.kill()
+            pytest.fail(f"{path} did not appear within the hang guard")
+        time.sleep(poll)
+    return Path(path).exists()
+
+
+def hidden_leftovers(root):
+    return sorted(str(p.relative_to(root)) for p in Path(root).rglob(".*"))
+
+
+def stop_reason(path):
+    return summary(path, verify=False)["stop_reason"]
+
+
+def stored(path):
+    with h5py.File(path, "r") as f:
+        attrs = f["parameters"].attrs
+        return (yaml.safe_load(str(attrs["config"])),
+                yaml.safe_load(str(attrs["resumes"])) if "resumes" in attrs else None)
+
+
+class HydraReached(Exception):
+    """The in-process entry point got as far as Hydra: the case was not refused before."""
+
+
+@pytest.fixture
+def entry(monkeypatch, capsys, tmp_path):
+    """``sim.cli.main()`` in this process, in ``tmp_path``, stopped (HydraReached) if it
+    gets as far as Hydra; returns a function of the command line giving a :class:`Result`."""
+    import sim.cli as main_module
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(main_module, "MADE_FOLDERS", [])
+    monkeypatch.setattr(main_module, "INTERRUPTED", [])
+    monkeypatch.setattr(main_module, "STOPPED_BY", [signal.SIGINT])
+    monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)
+    monkeypatch.setattr(runner.Interruption, "at_second_signal", None)
+
+    def reached():
+        raise HydraReached
+
+    monkeypatch.setattr(main_module, "hydra_main", reached)
+    previous = signal.getsignal(signal.SIGTERM)
+
+    def call(*args):
+        monkeypatch.setattr(sys, "argv", ["sim", QUIET, *args])
+        capsys.readouterr()
+        try:
+            main_module.main()
+            code = 0
+        except SystemExit as stop:
+            code = 0 if stop.code is None else stop.code
+        except HydraReached:
+            code = "not refused before Hydra started"
+        finally:
+            signal.signal(signal.SIGTERM, previous)
+        out, err = capsys.readouterr()
+        return Result(code, out, err)
+
+    return call
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    """A complete run file of :data:`SMALL` (200 disks, 2000 collisions)."""
+    folder = tmp_path_factory.mktemp("small")
+    result = sim(*SMALL, f"hydra.run.dir={folder / 'run'}", cwd=folder)
+    assert result.code == 0, result.err
+    return folder / "run" / "run.h5"
+
+
+def copy_run(small_run, tmp_path, name="prev"):
+    """The small run's folder copied to ``tmp_path/name``; returns its run file."""
+    folder = tmp_path / name
+    folder.mkdir()
+    shutil.copy2(small_run, folder / "run.h5")
+    return folder / "run.h5"
+
+
+# ---------------------------------------------------------------------------------------
+# bad input, refused before Hydra starts: exit 2, one line naming the key, nothing written
+
+BAD_INPUT = {
+    # integer keys
+    "collisions-2.5": ("stop.collisions=2.5", "stop.collisions"),
+    "collisions-abc": ("stop.collisions=abc", "stop.collisions"),
+    "collisions-0": ("stop.collisions=0", "stop.collisions"),
+    "collisions-1e400": ("stop.collisions=1e400", "stop.collisions"),
+    "collisions-above-2^62": ("stop.collisions=99999999999999999999", "stop.collisions"),
+    "n-0": ("disks.n=0", "disks.n"),
+    "n--5": ("disks.n=-5", "disks.n"),
+    "n-1e30": ("disks.n=1e30", "disks.n"),
+    "n-2^31": ("disks.n=2147483648", "disks.n"),
+    "bed.n-0-gas": ("bed.n=0", "bed.n"),
+    "bed.n-0-crater": ("scenario=crater bed.n=0", "bed.n"),
+    # non-finite and absurd numbers
+    "tc.time-nan": ("tc.time=nan", "tc.time"),
+    "tc-a-value": ("tc=nan", "tc"),
+    "speed-1e200": ("disks.speed=1e200", "disks.speed"),
+    "speed-1e-300": ("disks.speed=1e-300", "disks.speed"),
+    "speed-nan": ("disks.speed=nan", "disks.speed"),
+    "mass-inf": ("disks.mass=inf", "disks.mass"),
+    "temperature--1": ("disks.temperature=-1", "disks.temperature"),
+    "temperature--1-speed-null": ("disks.speed=null disks.temperature=-1",
+                                  "disks.temperature"),
+    "box-1e-300": ("box.size=[1e-300,1]", "box.size"),
+    "box-inf": ("box.size=[1,inf]", "box.size"),
+    "box-one-side": ("box.size=[1]", "box.size"),
+    "gravity-nan": ("gravity=[0,nan]", "gravity"),
+    "wall-T-inf": ("walls.left.temperature=inf", "walls.left.temperature"),
+    "wall-T-nan": ("walls.left.temperature=nan", "walls.left.temperature"),
+    "wall-T--1": ("walls.left.temperature=-1", "walls.left.temperature"),
+    "wall-speed-inf": ("walls.top.speed=inf", "walls.top.speed"),
+    "restitution-nan": ("restitution.disk=nan", "restitution.disk"),
+    "restitution-1.5": ("restitution.disk=1.5", "restitution.disk"),
+    "packing-0.95": ("disks.packing_fraction=0.95", "disks.packing_fraction"),
+    "every_time-0": ("output.every_time=0", "output.every_time"),
+    "wall_seconds-nan": ("stop.wall_seconds=nan", "stop.wall_seconds"),
+    "stop.time-inf": ("stop.time=inf", "stop.time"),
+    # seeds
+    "seed--1": ("seed=-1", "seed"),
+    "seed-1e23": ("seed=100000000000000000000000", "seed"),
+    "seed-1.5": ("seed=1.5", "seed"),
+    # scenes
+    "two_disks-n-5": ("scenario=two_disks disks.n=5", "disks.n"),
+    "mixture-empty-species": ("scenario=mixture disks.n=3 mixture.masses=[1,2,3,4,5] "
+                              "mixture.fractions=[0.2,0.2,0.2,0.2,0.2]", "mixture.fractions"),
+    "mixture-zero-fraction": ("scenario=mixture mixture.fractions=[0.5,0]",
+                              "mixture.fractions"),
+    "mixture-section-in-gas": ("mixture.fractions=[0.5,0]", "mixture.fractions"),
+    "scenario-nosuch": ("scenario=nosuch", "nosuch"),
+    "misspelt-disks.nn": ("disks.nn=3", "disks.nn"),
+    "sweep-item-abc": ("stop.collisions=2e6,abc -m", "abc"),
+    "sweep-item-nan": ("restitution.disk=0.5,nan -m", "restitution.disk"),
+    # resources
+    "memory-1e9-disks": ("disks.n=1000000000", "disks.n"),
+    "memory-1e9-disks-run.dir": ("disks.n=1000000000 hydra.run.dir=X/run", "disks.n"),
+    "memory-local-cells": ("observe.local_fields.cells=1000000", "observe.local_fields.cells"),
+    "memory-rdf-bins": ("observe.radial_distribution.bins=10000000000",
+                        "observe.radial_distribution.bins"),
+    "disk-full-every-collision": ("disks.n=2000 stop.collisions=100000000 "
+                                  "output.every_collisions=1", "output.every_collisions"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_INPUT), ids=list(BAD_INPUT))
+def test_bad_input_is_refused_with_one_line_and_nothing_written(case, entry, tmp_path):
+    command, key = BAD_INPUT[case]
+    args = command.split()
+    if "-m" in args:  # the sweep flag last, as the README writes it
+        args = [a for a in args if a != "-m"] + [f"hydra.sweep.dir={tmp_path}/S", "-m"]
+    (tmp_path / "keep.txt").write_text("a file that was here before")
+    before = tree(tmp_path)
+    result = entry(*args)
+    check(result, 2, [key], before, tree(tmp_path), nothing_new=True)
+
+
+def test_a_misspelt_key_is_quoted_with_the_value_given(entry, tmp_path):
+    """``disks.nn=3``: the message quotes what was typed (3), not ``None``."""
+    result = entry("disks.nn=3")
+    check(result, 2, ["disks.nn"])
+    assert "None" not in lines_of(result.err)[0], result.err
+
+
+# ---------------------------------------------------------------------------------------
+# numbers that look wrong but are fine: they run
+
+
+RUNS = {
+    "collisions-2e6": (["stop.collisions=2e6", "disks.n=200", "stop.wall_seconds=2"], None),
+    "n-1e3": (["disks.n=1e3", "stop.collisions=2000"], 1000),
+    "seed-2^63-1": (["seed=9223372036854775807", "disks.n=200", "stop.collisions=2000"], 200),
+}
+
+
+@pytest.mark.parametrize("case", list(RUNS), ids=list(RUNS))
+def test_numbers_written_as_floats_and_the_largest_seed_run(case, tmp_path):
+    args, n = RUNS[case]
+    result = sim(*args, "hydra.run.dir=run", cwd=tmp_path)
+    check(result, 0)
+    info = summary(tmp_path / "run" / "run.h5")
+    assert info["stop_reason"] in ("collisions", "wall_seconds")
+    if n is not None:
+        assert info["n"] == n
+    if case.startswith("seed"):
+        assert info["seed"] == 2**63 - 1
+    assert not hidden_leftovers(tmp_path)
+
+
+# ---------------------------------------------------------------------------------------
+# stop conditions that can never hold: refused (exit 2) before any work; and a scene at rest
+# that ends by itself
+
+NEVER = {
+    "single-disk-collisions": ("scenario=single_disk stop.collisions=10 stop.events=null",
+                               "stop.collisions"),
+    "parallel-pair-collisions": ("scenario=two_disks two_disks.velocities=[[0,1],[0,1]] "
+                                 "stop.collisions=10", "stop.collisions"),
+    "elastic-energy_fraction": ("disks.n=200 stop.collisions=null stop.energy_fraction=0.5",
+                                "stop.energy_fraction"),
+    "periodic-single-disk-events": ("scenario=single_disk box.boundary=periodic "
+                                    "stop.events=100", "stop.events"),
+    "single-disk-collisions-run.dir": ("scenario=single_disk stop.collisions=10 "
+                                       "stop.events=null hydra.run.dir=X", "stop.collisions"),
+}
+
+
+@pytest.mark.parametrize("case", list(NEVER), ids=list(NEVER))
+def test_a_stop_condition_that_can_never_hold_is_refused(case, tmp_path):
+    command, key = NEVER[case]
+    before = tree(tmp_path)
+    result = sim(*command.split(), cwd=tmp_path)
+    check(result, 2, [key], before, tree(tmp_path), nothing_new=True)
+
+
+def test_disks_at_rest_end_by_themselves(tmp_path):
+    result = sim("disks.n=200", "disks.speed=0", "output.every_collisions=null",
+                 "output.every_time=0.1", "stop.collisions=1000", "hydra.run.dir=run",
+                 cwd=tmp_path)
+    check(result, 0)
+    assert summary(tmp_path / "run" / "run.h5")["stop_reason"] == "no_events"
+    assert not hidden_leftovers(tmp_path)
+
+
+# ---------------------------------------------------------------------------------------
+# resume= of things that are not a resumable run file
+
+
+def _foreign(path):
+    with h5py.File(path, "w") as f:
+        f["x"] = np.arange(3)
+
+
+def _garbage_config(path):
+    with h5py.File(path, "r+") as f:
+        f["parameters"].attrs["config"] = "{{{: not yaml ]\n  - at all"
+
+
+def _edited_n(path):
+    with h5py.File(path, "r+") as f:
+        config = yaml.safe_load(str(f["parameters"].attrs["config"]))
+        config["disks"]["n"] = 100
+        f["parameters"].attrs["config"] = yaml.safe_dump(config)
+
+
+def _write(path, data):
+    if isinstance(data, str):
+        path.write_text(data)
+    else:
+        path.write_bytes(data)
+    return path
+
+
+def _then(action, path):
+    action(path)
+    return path
+
+
+BAD_RESUME = {
+    "missing": lambda folder, good: folder / "missing.h5",
+    "folder": lambda folder, good: good.parent,
+    "empty": lambda folder, good: _write(folder / "empty.h5", b""),
+    "text": lambda folder, good: _write(folder / "text.h5", "hello\n"),
+    "truncated": lambda folder, good: _write(folder / "cut.h5",
+                                             good.read_bytes()[: good.stat().st_size // 2]),
+    "foreign-hdf5": lambda folder, good: _then(_foreign, folder / "foreign.h5"),
+    "garbage-config": lambda folder, good: _then(_garbage_config, good),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_RESUME), ids=list(BAD_RESUME))
+def test_resume_of_what_is_not_a_run_file_is_refused(case, entry, small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    target = BAD_RESUME[case](tmp_path, good)
+    before = tree(tmp_path)
+    result = entry(f"resume={target}")
+    check(result, 2, ["resume"], before, tree(tmp_path), nothing_new=True)
+
+
+# ---------------------------------------------------------------------------------------
+# sim.inspect of what is not a run file: exit 2, one line naming the path
+
+
+@pytest.mark.parametrize("case", list(BAD_RESUME), ids=list(BAD_RESUME))
+def test_inspect_of_what_is_not_a_run_file_is_one_line(case, small_run, tmp_path, capsys):
+    from sim import inspect
+
+    good = copy_run(small_run, tmp_path)
+    target = BAD_RESUME[case](tmp_path, good)
+    before = tree(tmp_path)
+    capsys.readouterr()
+    code = inspect.main([str(target)])
+    out, err = capsys.readouterr()
+    check(Result(code, out, err), 2, [target.name], before, tree(tmp_path), nothing_new=True)
+
+
+@pytest.mark.parametrize("extra", [[], ["stop.collisions=4000"]], ids=["plain", "longer"])
+def test_resume_of_a_run_file_whose_config_was_edited_is_refused(extra, small_run, tmp_path):
+    """The stored config says disks.n=100, the checkpoint holds 200 disks: the file no longer
+    describes itself, and resuming must not write into it."""
+    good = copy_run(small_run, tmp_path)
+    _edited_n(good)
+    before = tree(tmp_path)
+    result = sim(f"resume={good}", *extra, cwd=tmp_path)
+    check(result, 2, [], before, tree(tmp_path), nothing_new=True,
+          any_of=("resume", "disks.n"))
+
+
+def test_resume_may_not_change_the_scene(entry, small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = entry(f"resume={good}", "disks.n=10")
+    check(result, 2, ["disks.n"], before, tree(tmp_path), nothing_new=True)
+
+
+def test_resume_as_a_sweep_is_refused(entry, small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = entry(f"resume={good}", f"hydra.sweep.dir={tmp_path}/S", "-m")
+    check(result, 2, ["resume"], before, tree(tmp_path), nothing_new=True)
+
+
+def test_resume_to_fewer_collisions_than_done_is_refused(small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = sim(f"resume={good}", "stop.collisions=1000", cwd=tmp_path)
+    check(result, 2, ["stop.collisions"], before, tree(tmp_path), nothing_new=True)
+
+
+def test_resume_to_more_collisions_continues_a_complete_run(small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    done = summary(good)["collisions"]
+    result = sim(f"resume={good}", "stop.collisions=4000", cwd=tmp_path)
+    check(result, 0)
+    info = summary(good)
+    assert info["collisions"] == 4000 > done and info["stop_reason"] == "collisions"
+    assert info["damaged"] == []
+    config, resumes = stored(good)
+    assert config["stop"]["collisions"] == 4000
+    assert resumes and any("stop.collisions=4000" in entry_["overrides"] for entry_ in resumes)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["prev", "run.h5"]  # no leftovers
+
+
+# ---------------------------------------------------------------------------------------
+# folders and files, never lost
+
+
+@pytest.fixture(scope="module")
+def live_run(tmp_path_factory):
+    """A run that would go on for hours, its run file published; SIGINT ends it at the
+    module's end (or in :func:`test_a_live_run_ends_on_sigint_with_its_file_whole`)."""
+    folder = tmp_path_factory.mktemp("live")
+    process = start(*FOREVER, f"hydra.run.dir={folder / 'X'}", cwd=folder)
+    appeared = wait_for(folder / "X" / "run.h5", process)
+    if not appeared:
+        result = finish(process)
+        pytest.fail(f"the long run ended before its file appeared: {result}")
+    yield process, folder
+    if process.poll() is None:
+        process.kill()
+        process.communicate(timeout=HANG_GUARD)
+
+
+def test_a_second_run_into_a_live_runs_folder_is_refused(live_run):
+    process, folder = live_run
+    before = set(tree(folder))
+    result = sim(*FOREVER, f"hydra.run.dir={folder / 'X'}", cwd=folder)
+    check(result, 2, ["hydra.run.dir", str(process.pid)])
+    assert process.poll() is None, "the first run died"
+    assert not set(tree(folder)) - before
+
+
+def test_inspect_of_a_live_run_file_is_one_line(live_run):
+    process, folder = live_run
+    done = subprocess.run([PY, "-m", "sim.inspect", str(folder / "X" / "run.h5")],
+                          cwd=folder, capture_output=True, text=True, timeout=HANG_GUARD)
+    check(Result(done.returncode, done.stdout, done.stderr), 2, ["run.h5"])
+
+
+def test_resume_of_a_live_run_file_is_refused(live_run):
+    process, folder = live_run
+    before = set(tree(folder))
+    result = sim(f"resume={folder / 'X' / 'run.h5'}", cwd=folder)
+    check(result, 2, ["resume"])
+    assert process.poll() is None, "the first run died"
+    assert not set(tree(folder)) - before
+
+
+def test_a_live_run_ends_on_sigint_with_its_file_whole(live_run):
+    process, folder = live_run
+    assert process.poll() is None, "the long run ended by itself"
+    process.send_signal(signal.SIGINT)
+    result = finish(process)
+    check(result, 130, ["resume="])
+    info = summary(folder / "X" / "run.h5")
+    assert info["stop_reason"] == "interrupted" and info["damaged"] == []
+    assert info["snapshots"] >= 1
+    assert not hidden_leftovers(folder)
+
+
+def test_four_runs_started_together_get_four_folders(tmp_path):
+    processes = [start(*SMALL, f"seed={k}", cwd=tmp_path) for k in range(4)]
+    results = [finish(p) for p in processes]
+    for result in results:
+        check(result, 0)
+    files = sorted(tmp_path.glob("outputs/runs/*/*/run.h5"))
+    assert len(files) == 4 and len({f.parent for f in files}) == 4
+    assert sorted(summary(f)["seed"] for f in files) == [0, 1, 2, 3]
+    assert not hidden_leftovers(tmp_path)
+
+
+def test_the_same_command_twice_at_once_into_one_folder(tmp_path):
+    """Both start together; whichever gets the folder runs, the other is refused (exit 2,
+    naming hydra.run.dir) or finds the run complete (exit 0): one intact run file."""
+    args = ["disks.n=2000", "stop.collisions=200000", "output.every_collisions=20000",
+            "hydra.run.dir=X"]
+    results = [finish(p) for p in [start(*args, cwd=tmp_path) for _ in range(2)]]
+    codes = sorted(r.code for r in results)
+    assert codes in ([0, 0], [0, 2]), [(r.code, r.err[-500:]) for r in results]
+    for result in results:
+        check(result, result.code, ["hydra.run.dir"] if result.code == 2 else [])
+    assert summary(tmp_path / "X" / "run.h5")["stop_reason"] == "collisions"
+    assert not hidden_leftovers(tmp_path)
+
+
+def test_a_complete_run_asked_for_again_is_left_as_it_is(small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = sim(*SMALL, f"hydra.run.dir={good.parent}", cwd=tmp_path)
+    check(result, 0, [], before, tree(tmp_path), nothing_new=True)
+    assert "is complete" in result.out
+
+
+def test_another_config_into_a_complete_runs_folder_is_refused(small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = sim("disks.n=300", "stop.collisions=2000", f"hydra.run.dir={good.parent}",
+                 cwd=tmp_path)
+    check(result, 2, ["disks.n", "200", "300"], before, tree(tmp_path), nothing_new=True)
+
+
+SWEEP = ["disks.n=100", "stop.collisions=1000", "restitution.disk=0.9,1.0"]
+
+
+def finished_sweep(folder):
+    """The sweep :data:`SWEEP` run into ``folder/S``."""
+    result = sim(*SWEEP, "hydra.sweep.dir=S", "-m", cwd=folder)
+    assert result.code == 0, result.err[-2000:]
+    return folder / "S"
+
+
+def test_another_sweep_into_a_sweep_folder_is_refused_before_any_job(tmp_path):
+    finished_sweep(tmp_path)
+    before = tree(tmp_path)
+    result = sim("disks.n=100", "stop.collisions=1000", "restitution.disk=0.8,0.7",
+                 "hydra.sweep.dir=S", "-m", cwd=tmp_path)
+    check(result, 2, ["hydra.sweep.dir", "restitution.disk"], before, tree(tmp_path),
+          nothing_new=True)
+
+
+def test_the_same_sweep_again_changes_nothing_and_reads_back_labelled(tmp_path):
+    from sim.analysis import open_sweep
+
+    finished_sweep(tmp_path)
+    before = tree(tmp_path)
+    result = sim(*SWEEP, "hydra.sweep.dir=S", "-m", cwd=tmp_path)
+    check(result, 0, [], before, tree(tmp_path), nothing_new=True)
+    assert result.out.count("is complete") == 2
+    sweep = open_sweep(tmp_path / "S")
+    labels = sweep["restitution_disk"].values.tolist()
+    assert labels == [0.9, 1.0]
+    for value in labels:
+        config = yaml.safe_load(str(sweep["config"].sel(restitution_disk=value).item()))
+        assert config["restitution"]["disk"] == value
+    recorded = sorted(stored(p)[0]["restitution"]["disk"]
+                      for p in (tmp_path / "S").glob("*/run.h5"))
+    assert recorded == labels
+
+
+def test_a_sweep_into_the_default_sweep_folder_runs(tmp_path):
+    """The README's sweep command: no hydra.sweep.dir, ``-m`` last."""
+    result = sim(*SWEEP, "-m", cwd=tmp_path)
+    check(result, 0)
+    files = sorted(tmp_path.glob("outputs/multirun/*/*/*/run.h5"))
+    assert len(files) == 2
+
+
+def test_a_run_folder_holding_a_foreign_run_h5_is_refused(tmp_path):
+    (tmp_path / "F").mkdir()
+    (tmp_path / "F" / "run.h5").write_text("my notes, not a run file\n")
+    before = tree(tmp_path)
+    result = sim(*SMALL, "hydra.run.dir=F", cwd=tmp_path)
+    check(result, 2, ["hydra.run.dir"], before, tree(tmp_path), nothing_new=True)
+
+
+def test_a_stale_lock_and_part_file_of_a_dead_run_do_not_block_the_folder(tmp_path):
+    folder = tmp_path / "L"
+    folder.mkdir()
+    (folder / ".run.h5.lock").write_text("999999")
+    (folder / ".run.h5.part").write_bytes(b"half a header")
+    result = sim(*SMALL, f"hydra.run.dir={folder}", cwd=tmp_path)
+    check(result, 0)
+    assert stop_reason(folder / "run.h5") == "collisions"
+    assert not hidden_leftovers(tmp_path)
+
+
+def test_a_run_folder_that_is_a_file_is_one_line_exit_1(tmp_path):
+    (tmp_path / "afile").write_text("not a folder")
+    before = tree(tmp_path)
+    result = sim(*SMALL, "hydra.run.dir=afile", cwd=tmp_path)
+    check(result, 1, ["afile"], before, tree(tmp_path), nothing_new=True)
+
+
+def test_a_run_file_outside_its_run_folder_is_refused(tmp_path):
+    """``output.file`` is the file's name in the run folder; ``../x.h5`` would put the run (and
+    its lock) beside every other run's folder, where two runs share it."""
+    before = tree(tmp_path)
+    result = sim(*SMALL, "output.file=../escape.h5", "hydra.run.dir=E", cwd=tmp_path)
+    check(result, 2, ["output.file"], before, tree(tmp_path), nothing_new=True)
+
+
+def test_a_run_folder_that_cannot_be_written_is_one_line_exit_1(tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        if os.access(locked, os.W_OK):  # root: permissions do not bind; /proc refuses all
+            target = "/proc/x/run"
+        else:
+            target = str(locked / "run")
+        before = tree(tmp_path)
+        result = sim(*SMALL, f"hydra.run.dir={target}", cwd=tmp_path)
+        check(result, 1, [target], before, tree(tmp_path), nothing_new=True)
+    finally:
+        locked.chmod(0o755)
+
+
+def _file_size_limit():
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    import resource
+    resource.setrlimit(resource.RLIMIT_FSIZE, (64 << 10, 64 << 10))
+
+
+def test_a_file_size_limit_at_the_first_write_is_one_line_exit_1(tmp_path):
+    result = finish(start("disks.n=2000", "stop.collisions=100000", "hydra.run.dir=F",
+                          cwd=tmp_path, preexec_fn=_file_size_limit))
+    assert not (tmp_path / "F" / "run.h5").exists()
+    assert not (tmp_path / "F" / ".run.h5.part").exists()
+    assert not hidden_leftovers(tmp_path)
+    check(result, 1, ["run.h5"])
+
+
+KILL_MOMENTS = ["5ms", "50ms", "folder-appears", "part-appears", "file-appears",
+                "file+0.3s"]
+
+
+@pytest.mark.parametrize("moment", KILL_MOMENTS)
+def test_sigkill_at_any_moment_leaves_a_readable_file_or_none(moment, tmp_path):
+    folder = tmp_path / "X"
+    process = start(*FOREVER, f"hydra.run.dir={folder}", cwd=tmp_path)
+    try:
+        if moment.endswith("ms"):
+            time.sleep(float(moment[:-2]) / 1000)
+        else:
+            target = {"folder-appears": folder, "part-appears": folder / ".run.h5.part",
+                      "file-appears": folder / "run.h5", "file+0.3s": folder / "run.h5"}
+            wait_for(target[moment], process, poll=0.001)
+            if moment == "file+0.3s":
+                time.sleep(0.3)
+    finally:
+        process.kill()
+        result = finish(process)
+    assert result.code == -signal.SIGKILL, result.err[-2000:]
+    path = folder / "run.h5"
+    if path.exists():
+        info = summary(path)  # reads, or raises
+        assert info["stop_reason"] == "running" and info["damaged"] == []
+        again = sim(f"resume={path}", f"stop.collisions={info['collisions'] + 40000}",
+                    cwd=tmp_path)
+    else:  # nothing published: the folder takes the run again
+        again = sim("disks.n=2000", "stop.collisions=40000", f"hydra.run.dir={folder}",
+                    cwd=tmp_path)
+    check(again, 0)
+    assert stop_reason(path) == "collisions"
+    assert not hidden_leftovers(tmp_path)
+
+
+# ---------------------------------------------------------------------------------------
+# every run ends
+
+
+def test_a_wall_clock_budget_ends_a_run_that_snapshots_every_collision(tmp_path):
+    result = sim("disks.n=200", "output.every_collisions=1", "stop.wall_seconds=3",
+                 "hydra.run.dir=run", cwd=tmp_path)
+    check(result, 0)
+    assert summary(tmp_path / "run" / "run.h5", verify=False)["stop_reason"] == "wall_seconds"
+
+
+def test_sigterm_ends_a_run_resumably_and_resume_finishes_it(tmp_path):
+    process = start(*FOREVER, "hydra.run.dir=X", cwd=tmp_path)
+    try:
+        assert wait_for(tmp_path / "X" / "run.h5", process), finish(process).err[-2000:]
+        time.sleep(0.3)
+    finally:
+        process.send_signal(signal.SIGTERM)
+        result = finish(process)
+    check(result, 143, ["resume="])
+    assert "resume=" in lines_of(result.err)[-1]
+    path = tmp_path / "X" / "run.h5"
+    info = summary(path)
+    assert info["stop_reason"] == "terminated" and info["damaged"] == []
+    again = sim(f"resume={path}", f"stop.collisions={info['collisions'] + 40000}",
+                cwd=tmp_path)
+    check(again, 0)
+    assert stop_reason(path) == "collisions"
+    assert not hidden_leftovers(tmp_path)
+
+
+def _catches_sigint(pid):
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return True  # gone: the caller sees it end
+    mask = int(re.search(r"SigCgt:\s*([0-9a-f]+)", status).group(1), 16)
+    return bool(mask & (1 << (signal.SIGINT - 1)))
+
+
+#: after CPython handles SIGINT at all (its own start-up before that is not sim's to handle):
+#: while the modules are imported; and once the run folder is made, before the run file
+STARTUP_MOMENTS = ["imports+0.1s", "imports+0.3s", "imports+0.6s", "folder-appears"]
+
+
+@pytest.mark.parametrize("moment", STARTUP_MOMENTS)
+def test_sigint_during_start_up_is_one_line_exit_130_and_leaves_nothing(moment, tmp_path):
+    process = start(*SMALL, "hydra.run.dir=X", cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + HANG_GUARD
+        if moment == "folder-appears":
+            wait_for(tmp_path / "X", process, poll=0.001)
+        else:
+            while not _catches_sigint(process.pid) and time.monotonic() < deadline:
+                time.sleep(0.001)
+            time.sleep(float(moment.split("+")[1][:-1]))
+        published = (tmp_path / "X" / "run.h5").exists()
+    finally:
+        process.send_signal(signal.SIGINT)
+        result = finish(process)
+    if "Fatal Python error: init" in result.err:
+        pytest.skip("SIGINT landed in CPython's own initialisation, before any code of sim")
+    assert not published, "the run file appeared before SIGINT was sent: not start-up"
+    check(result, 130, [])
+    files = [p for p in tmp_path.rglob("*") if not p.is_dir()]
+    assert not files, files
+    assert not (tmp_path / "X").exists() or not any((tmp_path / "X").iterdir())
+
+
+def test_two_quick_sigints_still_leave_a_readable_resumable_file(tmp_path):
+    """Ctrl-C pressed twice: the second acts at once (mid-chunk or mid-write); the file
+    that is left must still read, and resume must continue it."""
+    process = start(*FOREVER, "hydra.run.dir=X", cwd=tmp_path)
+    try:
+        assert wait_for(tmp_path / "X" / "run.h5", process), finish(process).err[-2000:]
+        time.sleep(0.3)
+        process.send_signal(signal.SIGINT)
+        time.sleep(0.02)
+    finally:
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)
+        result = finish(process)
+    path = tmp_path / "X" / "run.h5"
+    info = summary(path)
+    assert info["damaged"] == []
+    again = sim(f"resume={path}", f"stop.collisions={info['collisions'] + 40000}",
+                cwd=tmp_path)
+    check(again, 0)
+    assert stop_reason(path) == "collisions"
+    assert not hidden_leftovers(tmp_path)
+    check(result, 130, [])  # last: the file matters most
+
+
+def test_inelastic_collapse_is_exit_3_with_the_state_kept(tmp_path):
+    result = sim("disks.n=300", "restitution.disk=0.2", "tc.time=null",
+                 "disks.packing_fraction=0.6", "disks.placement=lattice",
+                 "stop.collisions=2000000", "hydra.run.dir=run", cwd=tmp_path)
+    check(result, 3, ["inelastic collapse"])
+    info = summary(tmp_path / "run" / "run.h5")
+    assert info["stop_reason"] == "inelastic_collapse" and info["damaged"] == []
+    assert not hidden_leftovers(tmp_path)
+
+
+def test_a_jammed_piston_is_exit_3_with_the_state_kept(tmp_path):
+    result = sim("disks.n=50", "disks.packing_fraction=0.05", "walls.top.speed=-0.5",
+                 "stop.collisions=null", "stop.wall_seconds=60",
+                 "output.every_collisions=100000", "hydra.run.dir=run", cwd=tmp_path)
+    check(result, 3, ["jammed"])
+    info = summary(tmp_path / "run" / "run.h5")
+    assert info["stop_reason"] == "closed_box" and info["damaged"] == []
+    assert not hidden_leftovers(tmp_path)
+
+
+# ---------------------------------------------------------------------------------------
+# the Python API
+
+
+def _engine_case(name):
+    position = [[0.2, 0.2], [0.5, 0.5], [0.8, 0.8]]
+    velocity = [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.5]]
+    if name == "overlap":
+        position[2] = [0.52, 0.5]
+    elif name == "outside":
+        position[2] = [0.99, 0.5]
+    elif name == "nan-velocity":
+        velocity[2] = [float("nan"), 0.0]
+    elif name == "nan-position":
+        position[2] = [float("nan"), 0.5]
+    elif name == "inf-velocity":
+        velocity[2] = [0.0, float("inf")]
+    return position, velocity
+
+
+@pytest.mark.parametrize("name", ["overlap", "outside", "nan-velocity", "nan-position",
+                                  "inf-velocity"])
+def test_the_engine_refuses_a_bad_disk_naming_it(name):
+    from sim.engine import Engine
+
+    position, velocity = _engine_case(name)
+    with pytest.raises(ValueError) as error:
+        Engine(position, velocity, 0.05)
+    message = str(error.value)
+    assert re.search(r"\bdisk 2\b", message), message
+    if name == "overlap":
+        assert re.search(r"\bdisk 1\b", message), message
+
+
+def test_the_engine_refuses_a_bad_mass_or_radius_naming_the_disk():
+    from sim.engine import Engine
+
+    position, velocity = _engine_case("none")
+    for options in ({"mass": [1.0, float("inf"), 1.0]}, {"mass": [1.0, -1.0, 1.0]}):
+        with pytest.raises(ValueError, match=r"\bdisk 1\b"):
+            Engine(position, velocity, 0.05, **options)
+    with pytest.raises(ValueError, match=r"\bdisk 1\b"):
+        Engine(position, velocity, [0.05, float("nan"), 0.05])
