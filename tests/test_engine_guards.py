@@ -46,10 +46,11 @@ def brute_first_overlap(position, radius, box, periodic, tolerance=1e-9):
 
 @settings(max_examples=60, deadline=None)
 @given(n=st.integers(2, 80), seed=st.integers(0, 10_000), periodic=st.booleans(),
-       spread=st.sampled_from([1.0, 3.0, 30.0]), size=st.floats(0.005, 0.08))
+       spread=st.sampled_from([1.0, 3.0, 30.0]), size=st.floats(0.005, 0.3))
 def test_first_overlap_is_the_first_disk_that_overlaps_one_before_it(n, seed, periodic, spread,
                                                                      size):
-    """Against all pairs, for radii spread over up to a factor 30 (several grid levels)."""
+    """Against all pairs, for radii spread over up to a factor 30 (several grid levels), and
+    disks so large that a periodic axis has only a few cells."""
     rng = np.random.default_rng(seed)
     radius = size * spread ** rng.uniform(-1.0, 0.0, n)
     box = np.array([1.0, 0.7])
@@ -70,7 +71,9 @@ def test_overlapping_disks_are_refused_naming_the_first():
     message = refused(r"^disk 17 at \[.*\] overlaps disk 3 \(distance 0\.03 < contact "
                       r"distance 0\.04\)", position, np.zeros((n, 2)), radius)
     assert "may touch" in message
-    # across the side of a periodic box
+    # across the side of a periodic box, also when an axis has three cells
+    refused("disk 1 at .* overlaps disk 0", [[0.05, 0.5], [0.95, 0.5]], np.zeros((2, 2)), 0.13,
+            boundary=Boundary(periodic=(True, True)))
     refused("disk 1 at .* overlaps disk 0", [[0.005, 0.5], [0.99, 0.5]], np.zeros((2, 2)), 0.01,
             boundary=Boundary(periodic=(True, True)))
     # a large disk over small ones given before it

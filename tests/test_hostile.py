@@ -237,6 +237,7 @@ BAD_INPUT = {
     "box-1e-300": ("box.size=[1e-300,1]", "box.size"),
     "box-inf": ("box.size=[1,inf]", "box.size"),
     "box-one-side": ("box.size=[1]", "box.size"),
+    "box-null-side": ("box.size=[1,null]", "box.size"),
     "gravity-nan": ("gravity=[0,nan]", "gravity"),
     "wall-T-inf": ("walls.left.temperature=inf", "walls.left.temperature"),
     "wall-T-nan": ("walls.left.temperature=nan", "walls.left.temperature"),
@@ -260,6 +261,9 @@ BAD_INPUT = {
                               "mixture.fractions"),
     "mixture-section-in-gas": ("mixture.fractions=[0.5,0]", "mixture.fractions"),
     "scenario-nosuch": ("scenario=nosuch", "nosuch"),
+    "output.file-outside": ("output.file=../escape.h5", "output.file"),
+    "two_disks-one-velocity": ("scenario=two_disks two_disks.velocities=[[1,0]]",
+                               "two_disks.velocities"),
     "misspelt-disks.nn": ("disks.nn=3", "disks.nn"),
     "sweep-item-abc": ("stop.collisions=2e6,abc -m", "abc"),
     "sweep-item-nan": ("restitution.disk=0.5,nan -m", "restitution.disk"),
@@ -333,6 +337,15 @@ NEVER = {
                                     "stop.events=100", "stop.events"),
     "single-disk-collisions-run.dir": ("scenario=single_disk stop.collisions=10 "
                                        "stop.events=null hydra.run.dir=X", "stop.collisions"),
+    "elastic-energy_fraction-gravity": ("disks.n=50 gravity=[0,-1] stop.collisions=null "
+                                        "stop.energy_fraction=0.5", "stop.energy_fraction"),
+    "elastic-energy_fraction-thermal-wall": ("disks.n=50 walls.top.temperature=2 "
+                                             "stop.collisions=null stop.energy_fraction=0.5",
+                                             "stop.energy_fraction"),
+    "periodic-overlap-across-the-side": ("scenario=two_disks box.boundary=periodic "
+                                         "disks.radius=0.13 "
+                                         "two_disks.positions=[[0.05,0.5],[0.95,0.5]]",
+                                         "two_disks.positions"),
 }
 
 
@@ -456,6 +469,17 @@ def test_resume_to_fewer_collisions_than_done_is_refused(small_run, tmp_path):
     before = tree(tmp_path)
     result = sim(f"resume={good}", "stop.collisions=1000", cwd=tmp_path)
     check(result, 2, ["stop.collisions"], before, tree(tmp_path), nothing_new=True)
+
+
+@pytest.mark.parametrize("harmless", ["output.progress=true", "stop.wall_seconds=100"])
+def test_resume_of_a_complete_run_with_a_harmless_override_says_complete(harmless, small_run,
+                                                                        tmp_path):
+    """A chained batch job resumes with a new budget: a complete run stays as it is."""
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = sim(f"resume={good}", harmless, cwd=tmp_path)
+    check(result, 0, [], before, tree(tmp_path), nothing_new=True)
+    assert "is complete" in result.out
 
 
 def test_resume_to_more_collisions_continues_a_complete_run(small_run, tmp_path):
@@ -706,6 +730,8 @@ def test_sigkill_at_any_moment_leaves_a_readable_file_or_none(moment, tmp_path):
     if path.exists():
         info = summary(path)  # reads, or raises
         assert info["stop_reason"] == "running" and info["damaged"] == []
+        with h5py.File(path, "r") as f:  # published with its first checkpoint complete
+            assert "latest" in f["checkpoint"].attrs
         again = sim(f"resume={path}", f"stop.collisions={info['collisions'] + 40000}",
                     cwd=tmp_path)
     else:  # nothing published: the folder takes the run again

@@ -163,8 +163,18 @@ def test_resume_falls_back_to_the_older_checkpoint_when_the_latest_is_damaged(in
             RuntimeWarning, match=f"checkpoint slot {slot} is damaged; resuming from slot a, "
                                   f"the checkpoint of snapshot 0 "):
         assert read_checkpoint(f)[2] == 1
+    written = []  # the slot each new checkpoint goes to: never the only intact one
+    original = runner.RunWriter._checkpoint
+
+    def recording(self, engine, t):
+        written.append("b" if self.file["checkpoint"].attrs["latest"] == "a" else "a")
+        original(self, engine, t)
+
     with pytest.warns(RuntimeWarning, match=f"slot {slot} is damaged"):
-        runner.resume(path)
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(runner.RunWriter, "_checkpoint", recording)
+            runner.resume(path)
+    assert written[0] == slot
     assert summary(path)["stop_reason"] == "collisions"
     assert summary(path)["damaged"] == []  # the damaged slot was written again
     for name in (POSITION, "observables/collisions/value"):

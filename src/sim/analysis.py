@@ -235,8 +235,13 @@ def open_sweep(multirun_dir):
 def granular_temperatures(position, velocity, mass, species, box, cells=8):
     """Temperature of each species in the frame of the local flow: velocities minus the
     mass-weighted mean velocity u of their cell on a ``cells`` × ``cells`` grid, then
-    T_s = ⟨m (v − u)² / 2⟩ over the disks of species s (2D, k_B = 1). A cooling gas grows
-    shear and clustering modes; their collective motion is flow, not temperature.
+    T_s = Σ_s m (v − u)²/2 / Σ_s (1 − m/M), sums over the disks of species s, M the mass of
+    a disk's cell (2D, k_B = 1). A cooling gas grows shear and clustering modes; their
+    collective motion is flow, not temperature. Subtracting u takes from each disk, on
+    average, the share m/M of its kinetic energy (at equilibrium ⟨m (v − u)²⟩/2 = T (1 − m/M)),
+    most from the heaviest: the denominator makes the estimate unbiased (N − 1 for N equal
+    disks), where the plain mean would put T₂/T₁ 2 % low for masses 1 and 4, 8 × 8 cells and
+    4000 disks.
 
     ``position``, ``velocity``: float64[T, N, 2]; ``mass``, ``species``: [N].
     Returns float64[T, n_species].
@@ -254,8 +259,9 @@ def granular_temperatures(position, velocity, mass, species, box, cells=8):
         flow /= np.maximum(weight, 1e-300)[:, None]
         peculiar = velocity[t] - flow[cell[t]]
         energy = 0.5 * mass * np.sum(peculiar**2, axis=1)
-        out[t] = np.bincount(species, weights=energy, minlength=n_species) / np.bincount(
-            species, minlength=n_species)
+        kept = 1.0 - mass / weight[cell[t]]
+        out[t] = (np.bincount(species, weights=energy, minlength=n_species)
+                  / np.bincount(species, weights=kept, minlength=n_species))
     return out
 
 

@@ -25,6 +25,7 @@ import os
 import re
 import signal
 import sys
+import warnings
 from collections import OrderedDict
 from pathlib import Path
 
@@ -184,6 +185,12 @@ def _compose(combination, hydra_config=False):
                        return_hydra_config=hydra_config)
 
 
+def _hydra_config(args):
+    """The config composed with Hydra's own node, from the command line's ``hydra…``
+    overrides (its folders, launcher, subdir)."""
+    return _compose([a for a in args if a.lstrip("+~").startswith("hydra")], hydra_config=True)
+
+
 def _task(combination):
     return [c for c in combination if not c.lstrip("+~").startswith("hydra")]
 
@@ -228,8 +235,26 @@ def check_command_line(args):
 
 
 def _given(args, key):
-    values = [a.partition("=")[2] for a in args if a.partition("=")[0] == key]
-    return values[-1] if values else None
+    """The value the command line gives ``key`` (the last, as Hydra takes it), unquoted by
+    Hydra's own grammar, or None."""
+    items = [a for a in args if a.partition("=")[0] == key]
+    if not items:
+        return None
+    value = OverridesParser.create().parse_override(items[-1]).value()
+    return None if value is None else str(value)
+
+
+def _quoted(text):
+    """``text`` as a value of Hydra's override grammar."""
+    if re.fullmatch(r"[\w./:+-]+", text):
+        return text
+    return "'" + text.replace("'", "\\'") + "'"
+
+
+def _with(args, key, value):
+    """The command line with ``key=value`` in place of what it gave ``key``, first (Hydra
+    takes overrides before its flags, such as -m)."""
+    return [f"{key}={_quoted(str(value))}", *(a for a in args if a.partition("=")[0] != key)]
 
 
 def _writable(folder):
@@ -252,36 +277,46 @@ def run_folder(args):
     sweeping = any(a in SWEEP_FLAGS for a in args)
     key = "hydra.sweep.dir" if sweeping else "hydra.run.dir"
     resume = _given(args, "resume")
-    if not sweeping and resume not in (None, "null") and _given(args, key) is None:
-        return [f"{key}={Path(resume).parent}", *args]  # no new folder for a resume
-    given = _given(args, key)
-    if given is not None:
-        _writable(Path(given))
-        return args
-    pattern = Path(OmegaConf.select(_compose([], hydra_config=True), key))
+    if not sweeping and resume is not None and _given(args, key) is None:
+        return _with(args, key, Path(resume).parent)  # no new folder for a resume
+    # the folder as Hydra would make it, interpolations such as ${now:…} resolved once here
+    given = Path(OmegaConf.select(_hydra_config(args), key))
+    if _given(args, key) is not None:
+        _writable(given)
+        return _with(args, key, given)
     try:
-        _make_folder(pattern.parent)
-        folder = new_folder(pattern)
+        _make_folder(given.parent)
+        folder = new_folder(given)
     except OSError as error:
-        _fail(f"cannot make the run folder {pattern}: {error.strerror or error}",
+        _fail(f"cannot make the run folder {given}: {error.strerror or error}",
               EXIT_RUN_FILE)
     MADE_FOLDERS.append(folder)
     _writable(folder)
-    return [f"{key}={folder}", *args]  # Hydra takes overrides before its flags (-m)
+    return _with(args, key, folder)
 
 
 def check_resources(args, configs):
-    """Refuse (exit 2) a job that cannot fit in memory or in its folder's disk; warn about
-    run files of several GB."""
+    """Refuse (exit 2) jobs that cannot fit (:func:`sim.resources.check`): in the memory of
+    this machine as many at once as the launcher runs (joblib: one per core), or each within
+    the memory a scheduler gives a job (submitit's ``mem_gb``); and all their files on the
+    disk of the run folder. Warn about run files of several GB."""
     sweeping = any(a in SWEEP_FLAGS for a in args)
     folder = Path(_given(args, "hydra.sweep.dir" if sweeping else "hydra.run.dir"))
-    for cfg in configs:
-        if cfg.resume is not None:
-            continue
-        try:
-            resources.check(cfg, folder)
-        except ConfigError as error:
-            _fail(str(error))
+    fresh = [cfg for cfg in configs if cfg.resume is None]
+    if not fresh:
+        return
+    launcher = _hydra_config(args).hydra.launcher
+    job_memory = (float(launcher.mem_gb) * 2**30
+                  if sweeping and launcher.get("mem_gb") is not None else None)
+    concurrent = 1
+    if sweeping and launcher.get("n_jobs") is not None:
+        n_jobs = int(launcher.n_jobs)
+        concurrent = min(len(fresh), (os.cpu_count() or 1) if n_jobs < 0 else n_jobs)
+    try:
+        resources.check(fresh, folder, concurrent, job_memory)
+    except ConfigError as error:
+        _fail(str(error))
+    for cfg in fresh:
         resources.warn_large(cfg)
 
 
@@ -290,8 +325,7 @@ def check_sweep_folder(args, configs):
     folder must hold nothing, or the same config's run, and no live run; else exit 2 before
     any job starts."""
     folder = Path(_given(args, "hydra.sweep.dir"))
-    subdir = _compose([a for a in args if a.startswith("hydra.sweep.subdir=")],
-                      hydra_config=True).hydra.sweep._get_node("subdir")._value()
+    subdir = _hydra_config(args).hydra.sweep._get_node("subdir")._value()
     if subdir != "${hydra.job.num}":
         return  # job folders named otherwise: each job checks its own folder as it starts
     for number, cfg in enumerate(configs):
@@ -302,15 +336,18 @@ def check_sweep_folder(args, configs):
             with RunLock(path):
                 stored, _ = stored_config(path, "hydra.sweep.dir")
         except FolderBusyError as error:
-            _fail(f"hydra.sweep.dir={str(folder)!r} is not allowed: a folder no other run "
-                  f"is using; process {error.pid} is writing {path}")
+            _fail(ConfigError("hydra.sweep.dir", str(folder), f"a folder no other run is "
+                              f"using: {error.holder} is writing {path}"))
+        except ConfigError as error:  # not a run file
+            _fail(ConfigError("hydra.sweep.dir", str(folder), f"a folder without foreign "
+                              f"files: job {number}'s {error.allowed}"))
         except OSError:
             continue  # the job itself reports what it cannot write
         differ = differences(stored, cfg, ignore=COSMETIC)
         if differ:
-            _fail(f"hydra.sweep.dir={str(folder)!r} is not allowed: a folder without "
-                  f"another sweep's runs; job {number} there differs in "
-                  f"{describe_differences(differ)}")
+            _fail(ConfigError("hydra.sweep.dir", str(folder), f"a folder without another "
+                              f"sweep's runs; job {number} there differs in "
+                              f"{describe_differences(differ)}"))
 
 
 @hydra.main(config_path=CONF_DIR, config_name="config", version_base="1.3")
@@ -331,9 +368,9 @@ def hydra_main(cfg):
         return {"failed": f"ConfigError: {error}"}
     except RunFileError as error:
         if not sweeping:
-            print(f"sim: {error}", file=sys.stderr, flush=True)
+            _remove_made_folders()
             # a file whose write failed can crash HDF5 when Python tears down: leave now
-            os._exit(EXIT_RUN_FILE)
+            leave(f"sim: {' '.join(str(error).split())}", EXIT_RUN_FILE)
         return {"failed": f"RunFileError: {error}"}
     except PhysicsBreakdown as error:
         if not sweeping:
@@ -386,6 +423,11 @@ def _stop_at_once(signum):
     os._exit(128 + signum)
 
 
+def _warn_in_one_line(message, category, filename, lineno, file=None, line=None):
+    """Warnings as the command line's other messages: one line."""
+    print(f"sim: warning: {' '.join(str(message).split())}", file=sys.stderr, flush=True)
+
+
 def _quiet_hdf5_teardown(unraisable):
     """HDF5 tries a failed write again as it releases the objects of that file, and h5py
     prints each failure; the run has reported the failure in one line already."""
@@ -399,6 +441,7 @@ def main():
     """The command line's entry point (see the module docstring)."""
     signal.signal(signal.SIGTERM, _terminate)  # before the run: SIGTERM as Ctrl-C
     sys.unraisablehook = _quiet_hdf5_teardown
+    warnings.showwarning = _warn_in_one_line
     Interruption.at_second_signal = _stop_at_once
     args = whole_numbers(sys.argv[1:])
     sweeping = any(a in SWEEP_FLAGS for a in args)

@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any, Optional
 
+import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
@@ -219,30 +220,36 @@ def integer_keys(node=SimConfig, prefix=""):
     return keys
 
 
-def _numbers(value):
+def flat(cfg):
+    """{dotted key: value} of every leaf of a config, interpolations resolved (lists stay
+    whole)."""
+    def walk(node, prefix):
+        for key, value in node.items():
+            if isinstance(value, dict) and value:
+                yield from walk(value, f"{prefix}{key}.")
+            else:
+                yield f"{prefix}{key}", value
+    return dict(walk(OmegaConf.to_container(cfg, resolve=True), ""))
+
+
+def _leaves(value):
+    """The items of a value, nested lists flattened."""
     if isinstance(value, (list, tuple)):
-        for item in value:
-            yield from _numbers(item)
-    elif isinstance(value, (int, float)) and not isinstance(value, bool):
-        yield value
+        return [leaf for item in value for leaf in _leaves(item)]
+    return [value]
 
 
 def _check_numbers(c):
     """Every number of the config finite, and every dimensional one 0 or within
     [SMALLEST, LARGEST]; seeds and counts have their own ranges."""
     counts = set(integer_keys())
-
-    def walk(node, prefix):
-        for key, value in node.items():
-            if isinstance(value, dict):
-                yield from walk(value, f"{prefix}{key}.")
-            else:
-                yield f"{prefix}{key}", value
-
-    for key, value in walk(OmegaConf.to_container(c), ""):
+    for key, value in flat(c).items():
         if key in counts or key == "resume":
             continue
-        for x in _numbers(value):
+        if isinstance(value, list) and None in _leaves(value):
+            raise ConfigError(key, value, "numbers, not null")
+        for x in (x for x in _leaves(value)
+                  if isinstance(x, (int, float)) and not isinstance(x, bool)):
             if not math.isfinite(x):
                 raise ConfigError(key, value, "finite numbers")
             if x != 0 and not SMALLEST <= abs(x) <= LARGEST:
@@ -318,6 +325,34 @@ def _validate_bed(c):
         raise ConfigError("bed.n", b.n, f"at most a packing fraction of 0.85 in the bed "
                           f"region (this is {bed_phi:.3f}): fewer or smaller bed disks, or "
                           f"a higher bed.height")
+
+
+def _pair(c, key, allowed):
+    """The config list at ``key`` as float64[2, 2], or :class:`ConfigError` naming it."""
+    value = OmegaConf.to_container(OmegaConf.select(c, key))
+    try:
+        pair = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        pair = None
+    if pair is None or pair.shape != (2, 2):
+        raise ConfigError(key, value, allowed)
+    return pair
+
+
+def _validate_two_disks(c):
+    """Two positions and two velocities; the disks apart, across a periodic side too."""
+    position = _pair(c, "two_disks.positions", "two points [[x, y], [x, y]]")
+    _pair(c, "two_disks.velocities", "two velocities [[vx, vy], [vx, vy]]")
+    if c.disks.radius is None:
+        raise ConfigError("disks.radius", None, "the radius of the two disks")
+    box = np.array([float(x) for x in c.box.size])
+    r = position[0] - position[1]
+    if c.box.boundary == "periodic":
+        r -= box * np.round(r / box)
+    if np.hypot(*r) < 2.0 * c.disks.radius:
+        raise ConfigError("two_disks.positions", position.tolist(),
+                          f"two points [[x, y], [x, y]] at least 2 R = "
+                          f"{2.0 * c.disks.radius:.6g} apart (the disks must not overlap)")
 
 
 def validate(cfg: Any) -> None:
@@ -441,6 +476,8 @@ def validate(cfg: Any) -> None:
             raise ConfigError("mixture.fractions", list(m.fractions),
                               f"fractions that give every species at least one of the "
                               f"disks.n={d.n} disks (a species gets floor(fraction × n))")
+    if c.scene == "two_disks":
+        _validate_two_disks(c)
     if c.scene == "scattering":
         sc = c.scattering
         _positive(c, "scattering.target_radius", sc.target_radius, allow_none=False)

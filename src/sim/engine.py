@@ -160,7 +160,7 @@ def _closing_time(motion, box, periodic, largest_radius):
 #: it sets none). stall_dt is then the time in which such a disk moves 256–512 ulps of D: a
 #: float64 resolution, not a physical time. A chain of disks touching all round a periodic box
 #: creeps on by round-off, at most about 2 ulps of the box side per contact (measured), and is
-#: caught; the former guard, events at exactly one instant, never caught it.
+#: caught.
 #:
 #: A real gas never trips it: the intervals between its events are near exponential, with
 #: mean m = (mean time between a disk's events) / N, and a run of k = 16 N + 1000 of them all
@@ -267,14 +267,19 @@ def _first_overlap(position, radius, level, reach, cells, box, periodic, toleran
             cy = min(int(y / width_y), ny - 1)
             kx = int(math.ceil((radius[i] + reach[k]) / width_x))
             ky = int(math.ceil((radius[i] + reach[k]) / width_y))
-            if periodic[0] and 2 * kx + 1 < nx:
+            # a periodic axis narrower than the reach: every cell, each once
+            if not periodic[0]:
+                x_lo, x_hi = max(cx - kx, 0), min(cx + kx + 1, nx)
+            elif 2 * kx + 1 < nx:
                 x_lo, x_hi = cx - kx, cx + kx + 1
             else:
-                x_lo, x_hi = max(cx - kx, 0), min(cx + kx + 1, nx)
-            if periodic[1] and 2 * ky + 1 < ny:
+                x_lo, x_hi = 0, nx
+            if not periodic[1]:
+                y_lo, y_hi = max(cy - ky, 0), min(cy + ky + 1, ny)
+            elif 2 * ky + 1 < ny:
                 y_lo, y_hi = cy - ky, cy + ky + 1
             else:
-                y_lo, y_hi = max(cy - ky, 0), min(cy + ky + 1, ny)
+                y_lo, y_hi = 0, ny
             for ay in range(y_lo, y_hi):
                 row = first_cell[k] + (ay % ny) * nx
                 for ax in range(x_lo, x_hi):
@@ -849,7 +854,9 @@ class Engine:
         wall_seconds : wall-clock budget of this call, checked between chunks, which are then
             sized to take about :data:`TIMED_CHUNK_SECONDS` each (from the rate of the chunk
             before; the first has :data:`TIMED_FIRST_CHUNK` events)
-        until : predicate ``until(engine) -> bool`` checked between chunks
+        until : predicate ``until(engine) -> bool`` asked every ``chunk_events`` events from
+            the start of the call, whatever the chunks a wall budget makes: the same inputs
+            stop at the same event
         chunk_events : events per compiled call (the most, with ``wall_seconds``)
 
         The piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended
@@ -873,11 +880,12 @@ class Engine:
                    loop.STATUS_NO_EVENTS: "no_events"}
         chunk = int(chunk_events) if wall_seconds is None else min(int(chunk_events),
                                                                    TIMED_FIRST_CHUNK)
+        ask_at = self.steps + int(chunk_events)  # where ``until`` is asked next
         while True:
             chunk_started = wallclock.perf_counter()
             steps = self.steps
-            status = self._run_chunk(steps + chunk, max_contacts, max_collisions, t_stop,
-                                     dissipation_limit)
+            status = self._run_chunk(min(steps + chunk, ask_at), max_contacts, max_collisions,
+                                     t_stop, dissipation_limit)
             self._check_piston()
             if status != loop.STATUS_EVENT_LIMIT:
                 if closing and status == loop.STATUS_TIME_REACHED:
@@ -892,8 +900,10 @@ class Engine:
                     return "wall_seconds"
                 rate = (self.steps - steps) / max(now - chunk_started, 1e-6)
                 chunk = int(np.clip(rate * TIMED_CHUNK_SECONDS, TIMED_MIN_CHUNK, chunk_events))
-            if until is not None and until(self):
-                return "predicate"
+            if self.steps >= ask_at:
+                ask_at += int(chunk_events)
+                if until is not None and until(self):
+                    return "predicate"
 
     def _check_piston(self):
         """Raise :class:`ClosedBoxError` when a piston has jammed the disks (see

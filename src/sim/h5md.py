@@ -306,6 +306,7 @@ class RunWriter:
         for name in ("time", "snapshots"):  # incomplete until they are written again
             if name in group.attrs:
                 del group.attrs[name]
+        self._flush_file()  # on disk as incomplete before any of its data changes
         for key, value in state.items():
             value = np.asarray(value)
             scalar = value.ndim == 0  # stored as [1]: a chunked dataset, so with a checksum
@@ -326,10 +327,15 @@ class RunWriter:
         group.attrs["snapshots"] = self.file["particles/disks/position/step"].shape[0]
         self._flush_file()
         root.attrs["latest"] = slot
+        self._flush_file()
 
-    def truncate(self, snapshots, contacts):
-        """Drop frames written after the first ``snapshots`` ones, and logged contacts after
-        the ``contacts``-th (before resuming)."""
+    def truncate(self, snapshots, contacts, slot):
+        """Before resuming from the checkpoint in ``slot``: make it the latest (so that the
+        next checkpoint goes to the other slot, also when ``slot`` is the older one, its newer
+        neighbour damaged), and drop frames written after the first ``snapshots`` ones and
+        logged contacts after the ``contacts``-th."""
+        self.file["checkpoint"].attrs["latest"] = slot
+        self._flush_file()
         for group in [self.file["particles/disks/position"], self.file["particles/disks/velocity"],
                       *self.file["observables"].values()]:
             for name in ("step", "time", "value"):
@@ -407,14 +413,15 @@ def _slot_state(group):
 
 
 def read_checkpoint(file):
-    """The engine state of the latest complete checkpoint, its time and its snapshot count.
-    When that slot is damaged, the other slot's older checkpoint, with a RuntimeWarning;
-    :class:`sim.inspect.RunFileError` when no complete checkpoint is intact."""
+    """The engine state of the latest complete checkpoint, its time, its snapshot count and
+    its slot. When that slot is damaged, the other slot's older checkpoint, with a
+    RuntimeWarning; :class:`sim.inspect.RunFileError` when no complete checkpoint is intact."""
     root = file["checkpoint"]
     latest = str(root.attrs["latest"])
     state = _slot_state(root[latest])
     if state is not None:
-        return state, float(root[latest].attrs["time"]), int(root[latest].attrs["snapshots"])
+        return (state, float(root[latest].attrs["time"]), int(root[latest].attrs["snapshots"]),
+                latest)
     older = "b" if latest == "a" else "a"
     complete = older in root and {"time", "snapshots"} <= set(root[older].attrs)
     state = _slot_state(root[older]) if complete else None
@@ -426,4 +433,4 @@ def read_checkpoint(file):
     warnings.warn(f"{file.filename}: checkpoint slot {latest} is damaged; resuming from slot "
                   f"{older}, the checkpoint of snapshot {snapshots - 1} (t = {time:.6g})",
                   RuntimeWarning, stacklevel=2)
-    return state, time, snapshots
+    return state, time, snapshots, older

@@ -137,9 +137,42 @@ def estimate(cfg):
             "file": (sum(file_parts.values()), max(file_parts, key=file_parts.get))}
 
 
+#: the memory files of a control group, v2 then v1: (limit, usage)
+CGROUP_FILES = (("", "memory.max", "memory.current"),
+                ("memory", "memory.limit_in_bytes", "memory.usage_in_bytes"))
+
+
+def _cgroup_room():
+    """Bytes left under the memory limits of this process's control groups (v2 or v1; the
+    tightest limit along each group's path, a job's under a scheduler's), or inf."""
+    room = math.inf
+    try:
+        groups = Path("/proc/self/cgroup").read_text().splitlines()
+    except OSError:
+        return room
+    for line in groups:
+        _, controllers, path = line.split(":", 2)
+        for controller, limit_file, usage_file in CGROUP_FILES:
+            if controller not in controllers.split(","):  # v2 lists none: ""
+                continue
+            base = Path("/sys/fs/cgroup", controller)
+            folder = base / path.lstrip("/")
+            while folder.is_relative_to(base):
+                try:
+                    limit = int(Path(folder, limit_file).read_text())
+                    usage = int(Path(folder, usage_file).read_text())
+                    room = min(room, limit - usage)
+                except (OSError, ValueError):  # no such file, or "max": no limit here
+                    pass
+                if folder == base:
+                    break
+                folder = folder.parent
+    return room
+
+
 def available_memory():
     """Bytes of memory this process may still take: what the kernel calls available, or
-    the room left under the control group's limit when that is smaller."""
+    the room left under its control groups' limits when that is smaller."""
     available = math.inf
     try:
         with open("/proc/meminfo") as meminfo:
@@ -150,14 +183,7 @@ def available_memory():
         pages = os.sysconf("SC_AVPHYS_PAGES") if hasattr(os, "sysconf") else -1
         if pages > 0:
             available = pages * os.sysconf("SC_PAGE_SIZE")
-    try:
-        limit = Path("/sys/fs/cgroup/memory.max").read_text().strip()
-        used = int(Path("/sys/fs/cgroup/memory.current").read_text())
-        if limit != "max":
-            available = min(available, int(limit) - used)
-    except (OSError, ValueError):
-        pass
-    return available
+    return min(available, _cgroup_room())
 
 
 def _size(nbytes):
@@ -174,23 +200,36 @@ def _existing_parent(folder):
     return folder
 
 
-def check(cfg, folder):
-    """Refuse a run of ``cfg`` into ``folder`` that cannot fit in memory or on the disk
-    (:class:`ConfigError` naming the key that drives the estimate)."""
-    need = estimate(cfg)
-    memory, key = need["memory"]
-    available = available_memory()
-    if memory > available:
+def check(configs, folder, concurrent=1, job_memory=None):
+    """Refuse runs that cannot fit (:class:`ConfigError` naming the key that drives the
+    estimate): the ``concurrent`` largest of ``configs`` (one run's, or a sweep's jobs) in
+    memory at once — or each within ``job_memory`` bytes, a scheduler's limit per job — and
+    the files of all of them on the disk of ``folder``."""
+    needs = [(estimate(cfg), cfg) for cfg in configs]
+    if job_memory is None:
+        largest = sorted(needs, key=lambda need: need[0]["memory"][0])[-concurrent:]
+        memory = sum(need["memory"][0] for need, _ in largest)
+        room, where = available_memory(), "the machine has"
+    else:
+        largest = [max(needs, key=lambda need: need[0]["memory"][0])]
+        memory, room, where = largest[0][0]["memory"][0], job_memory, "a job may take"
+    if memory > room:
+        (need, cfg) = largest[-1]
+        key = need["memory"][1]
+        at_once = f" ({len(largest)} jobs at once)" if len(largest) > 1 else ""
         raise ConfigError(key, _value(cfg, key),
-                          f"a run that fits in memory: it needs about {_size(memory)}, the "
-                          f"machine has {_size(available)} available")
-    nbytes, key = need["file"]
+                          f"a run that fits in memory: it needs about {_size(memory)}"
+                          f"{at_once}, {where} {_size(room)}")
+    nbytes = sum(need["file"][0] for need, _ in needs)
     free = shutil.disk_usage(_existing_parent(folder)).free
     if SURELY_KEPT * nbytes > free:
+        need, cfg = max(needs, key=lambda need: need[0]["file"][0])
+        key = need["file"][1]
+        files = f" ({len(needs)} run files)" if len(needs) > 1 else ""
         raise ConfigError(key, _value(cfg, key),
                           f"a run file that fits on the disk: it would take at least "
-                          f"{_size(SURELY_KEPT * nbytes)}, {_existing_parent(folder)} has "
-                          f"{_size(free)} free (fewer snapshots: a larger "
+                          f"{_size(SURELY_KEPT * nbytes)}{files}, {_existing_parent(folder)} "
+                          f"has {_size(free)} free (fewer snapshots: a larger "
                           f"output.every_collisions or output.every_time)")
 
 

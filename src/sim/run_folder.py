@@ -6,7 +6,8 @@ life, and a new run file that appears whole or not at all.
 * :class:`RunLock` is an exclusive ``flock`` on the hidden file ``.run.h5.lock`` beside the
   run file, taken before the run file is read or written and released when the run ends; the
   kernel releases it when the process dies, so a killed run never leaves a stale lock. A
-  second process that asks for it is refused at once, naming the holder's pid.
+  second process that asks for it is refused at once, naming the holder's pid. On a file
+  system without file locks (some Lustre and NFS mounts) the run goes on with a warning.
 * A new run file is written under the hidden name ``.run.h5.part`` (:func:`part_path`) and
   linked into place once its header, first snapshot and first checkpoint are on disk
   (:func:`publish`): a run killed at any moment leaves a readable run file or none.
@@ -15,17 +16,21 @@ life, and a new run file that appears whole or not at all.
 import errno
 import fcntl
 import os
+import warnings
 from pathlib import Path
+
+#: flock's errors on a file system that has no file locks (some Lustre and NFS mounts)
+NO_LOCKS = (errno.ENOLCK, errno.ENOSYS, errno.EOPNOTSUPP)
 
 
 class FolderBusyError(RuntimeError):
-    """Another live process holds the lock of this run file."""
+    """Another live process holds the lock of this run file; ``holder`` names it."""
 
     def __init__(self, path, pid):
-        self.path, self.pid = path, pid
-        holder = f"process {pid}" if pid else "another process"
-        super().__init__(f"{path} is being written by {holder}, a run still going; wait for "
-                         f"it to end or choose another folder")
+        self.path = path
+        self.holder = f"process {pid}" if pid else "another process"
+        super().__init__(f"{path} is being written by {self.holder}, a run still going; wait "
+                         f"for it to end or choose another folder")
 
 
 def new_folder(base):
@@ -69,6 +74,16 @@ class RunLock:
                 holder = os.read(fd, 32).decode(errors="replace").strip()
                 os.close(fd)
                 raise FolderBusyError(self.path, holder) from None
+            except OSError as error:
+                os.close(fd)
+                if error.errno not in NO_LOCKS:
+                    raise
+                self.file.unlink(missing_ok=True)
+                warnings.warn(f"the file system of {self.path} has no file locks: nothing "
+                              f"stops a second run from writing there", RuntimeWarning,
+                              stacklevel=2)
+                part_path(self.path).unlink(missing_ok=True)
+                return self
             # a releasing process unlinks the lock file: the one locked must still be there
             try:
                 same = os.path.samestat(os.fstat(fd), os.stat(self.file))
@@ -85,9 +100,10 @@ class RunLock:
         return self
 
     def __exit__(self, *exc):
-        self.file.unlink(missing_ok=True)
-        os.close(self._fd)
-        self._fd = None
+        if self._fd is not None:
+            self.file.unlink(missing_ok=True)
+            os.close(self._fd)
+            self._fd = None
         return False
 
 
@@ -96,11 +112,9 @@ def publish(part, path):
     :class:`FileExistsError`)."""
     try:
         os.link(part, path)
-    except FileExistsError:
-        raise
     except OSError as error:
         if error.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV, errno.EMLINK):
-            raise
+            raise  # FileExistsError among them
         # a file system without hard links: the lock keeps other runs away from ``path``
         if Path(path).exists():
             raise FileExistsError(errno.EEXIST, f"{path} exists") from error

@@ -34,7 +34,7 @@ from tqdm import tqdm
 
 import sim
 from sim import resources
-from sim.config import ConfigError, SimConfig, validate
+from sim.config import ConfigError, SimConfig, flat, validate
 from sim.engine import Engine, PhysicsBreakdown
 from sim.h5md import DiskFullError, RunWriter, hdf5_reason, read_checkpoint
 from sim.inspect import RunFileError as UnreadableRunFile
@@ -61,6 +61,11 @@ COSMETIC = ("stop.wall_seconds", "output.progress")
 
 class RunFileError(OSError):
     """The run file cannot be created or written (read-only folder, full disk)."""
+
+
+def _cannot_write(path, error, then=""):
+    """:class:`RunFileError` for a run file that could not be made, and why."""
+    return RunFileError(f"cannot write the run file {path}: {hdf5_reason(error)}{then}")
 
 
 class Interruption:
@@ -176,6 +181,17 @@ def every_collisions(cfg, n):
     return None if out.every_time is not None else int(n)
 
 
+def next_snapshot_time(last_time, every_time):
+    """``last_time + every_time`` (None without a cadence in time), or :class:`ConfigError`
+    once float64 cannot tell the two apart (a long run, a short cadence)."""
+    if every_time is None:
+        return None
+    if last_time + every_time <= last_time:
+        raise ConfigError("output.every_time", every_time,
+                          f"a cadence that float64 can add to t = {last_time:.6g}")
+    return last_time + every_time
+
+
 def advance(engine, cfg, writer, last_time, started, interruption):
     """Run from snapshot to snapshot (the last one at ``last_time``) until a stop condition
     holds, the wall-clock budget (counted from ``started``, a ``time.perf_counter()``) is
@@ -197,7 +213,7 @@ def advance(engine, cfg, writer, last_time, started, interruption):
     try:
         while True:
             next_collisions = engine.collisions + cadence if cadence else None
-            next_time = last_time + out.every_time if out.every_time else None
+            next_time = next_snapshot_time(last_time, out.every_time)
             collisions = min(x for x in (stop.collisions, next_collisions, math.inf)
                              if x is not None)
             t_stop = min(x for x in (stop.time, next_time, math.inf) if x is not None)
@@ -206,22 +222,25 @@ def advance(engine, cfg, writer, last_time, started, interruption):
                 time=None if t_stop == math.inf else t_stop,
                 energy_fraction=stop.energy_fraction, wall_seconds=budget(), until=until)
             snapshot_time = t_stop if reason == "time" else None
+            last_time = engine.time if snapshot_time is None else snapshot_time
+            met = {"collisions": stop.collisions is not None
+                   and engine.collisions >= stop.collisions,
+                   "time": stop.time is not None and last_time >= stop.time,
+                   "events": True, "energy_fraction": True}.get(reason, False)
             if reason in ("time", "no_events") and math.isinf(engine.next_event_time()):
                 # nothing will ever move again: the run is over
-                reason = "no_events"
+                reason, met = "no_events", True
                 if stop.time is not None:
-                    snapshot_time = max(stop.time, engine.time)
+                    snapshot_time = last_time = max(stop.time, engine.time)
+            elif met:
+                pass  # a stop condition holds: it names the end, whatever else came
+            elif resting is not None and resting(engine):
+                reason, met = "at_rest", True  # asked between chunks and at every snapshot
             elif interruption.requested:
-                reason = interruption.reason
-            elif reason == "predicate" or (resting is not None and resting(engine)):
-                reason = "at_rest"  # checked between chunks and at every snapshot
+                reason, met = interruption.reason, True
             elif budget() == 0.0:
-                reason = "wall_seconds"  # also when snapshots come faster than chunks
-            last_time = engine.time if snapshot_time is None else snapshot_time
-            last = {"collisions": stop.collisions is not None
-                    and engine.collisions >= stop.collisions,
-                    "time": stop.time is not None and last_time >= stop.time,
-                    }.get(reason, True)
+                reason, met = "wall_seconds", True  # also when snapshots outpace chunks
+            last = met
             writer.snapshot(engine, snapshot_time, checkpoint=last)
             bar.update(engine.collisions - bar.n)
             bar.set_postfix(t=f"{last_time:.4g}", energy=f"{engine.kinetic_energy():.4g}")
@@ -240,8 +259,7 @@ def _writer(path, engine, cfg, overrides=(), mode="w-", observers=None):
         return RunWriter(path, engine, parameters(cfg, overrides), mode=mode,
                          observers=observers)
     except OSError as error:
-        raise RunFileError(f"cannot write the run file {path}: "
-                           f"{error.strerror or error}") from error
+        raise _cannot_write(path, error) from error
 
 
 def _record(writer, engine, work):
@@ -271,8 +289,11 @@ def _record_interruptible(writer, engine, work):
         reason = hdf5_reason(error)
         raise RunFileError(f"writing the run file {writer.path} failed: {reason}") from error
     except PhysicsBreakdown as error:
-        writer.snapshot(engine, checkpoint=True)
-        writer.finish(error.stop_reason, message=str(error))
+        try:
+            writer.snapshot(engine, checkpoint=True)
+            writer.finish(error.stop_reason, message=str(error))
+        except OSError:  # no room for the last snapshot: the cause, at least
+            writer.give_up(error.stop_reason)
         raise
     except BaseException as error:
         writer.finish(f"error: {type(error).__name__}: {error}")
@@ -287,21 +308,10 @@ def _as_config(cfg):
     return OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
 
 
-def _flat(cfg):
-    """{dotted key: value} of every leaf of a config (lists stay whole)."""
-    def walk(node, prefix):
-        for key, value in node.items():
-            if isinstance(value, dict) and value:
-                yield from walk(value, f"{prefix}{key}.")
-            else:
-                yield f"{prefix}{key}", value
-    return dict(walk(OmegaConf.to_container(cfg, resolve=True), ""))
-
-
 def differences(stored, cfg, ignore=()):
     """{key: (value in ``stored``, value in ``cfg``)} for every key in which two configs
     differ, but those of ``ignore``."""
-    a, b = _flat(stored), _flat(cfg)
+    a, b = flat(stored), flat(cfg)
     return {key: (a.get(key), b.get(key)) for key in sorted({*a, *b})
             if key not in ignore and a.get(key) != b.get(key)}
 
@@ -345,7 +355,7 @@ def stored_config(path, key="resume"):
 def _check_consistent(path, cfg, key="resume"):
     """Refuse (:class:`ConfigError` on ``key``) a run file whose disks, box or checkpoint do
     not have the sizes its stored config ``cfg`` implies (a config edited in the file)."""
-    n, n_key = resources.disk_count(cfg)
+    n, _ = resources.disk_count(cfg)
     periodic = cfg.box.boundary == "periodic"
     try:
         with open_run_file(path) as f:
@@ -370,8 +380,9 @@ def _check_consistent(path, cfg, key="resume"):
 
 
 def resumable(path, overrides=()):
-    """The config ``resume(path, overrides)`` would run, validated, after every check that
-    resume makes before it writes (:class:`ConfigError`)."""
+    """The config ``resume(path, overrides)`` would run, validated, after the checks of the
+    file that need no engine: a run file, not in use, its data of the sizes its config
+    implies, the overrides allowed (:class:`ConfigError`)."""
     path = _existing_file(path, "resume")
     with _locked(path, "resume"):
         stored, _ = stored_config(path)
@@ -390,14 +401,12 @@ def _locked(path, key):
     try:
         lock.__enter__()
     except FolderBusyError as error:
-        holder = f"process {error.pid}" if error.pid else "another process"
         what = "run file" if key == "resume" else "folder"
         raise ConfigError(key, str(path if key == "resume" else path.parent),
-                          f"a {what} that no other run is using: {holder} is writing "
+                          f"a {what} that no other run is using: {error.holder} is writing "
                           f"{path}; wait for it to end, or choose another") from None
     except OSError as error:
-        raise RunFileError(f"cannot write the run file {path}: "
-                           f"{error.strerror or error}") from error
+        raise _cannot_write(path, error) from error
     try:
         yield
     finally:
@@ -420,12 +429,11 @@ def run(cfg, output_dir=".", overrides=(), folder_key="output_dir"):
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        raise RunFileError(f"cannot write the run file {path}: "
-                           f"{error.strerror or error}") from error
+        raise _cannot_write(path, error) from error
     with _locked(path, folder_key):
         if path.exists():
-            return _again(path, cfg, folder_key, started)
-        resources.check(cfg, path.parent)
+            return _existing_run(path, cfg, folder_key, started)
+        resources.check([cfg], path.parent)
         engine = build_engine(cfg)
         check_reachable(cfg, engine)
         return _new_run(path, engine, cfg, overrides, started)
@@ -450,17 +458,16 @@ def _new_run(path, engine, cfg, overrides, started):
     except RunFileError as error:
         if published:
             raise
-        cause = error.__cause__ or error
-        raise RunFileError(f"cannot write the run file {path}: "
-                           f"{getattr(cause, 'strerror', None) or cause}; nothing was "
-                           f"written") from error
+        raise _cannot_write(path, error.__cause__ or error, "; nothing was written") \
+            from error
     finally:
         part.unlink(missing_ok=True)
     return path
 
 
-def _again(path, cfg, key, started):
-    """The run file of ``cfg`` is there already: return it complete, resume it, or refuse."""
+def _existing_run(path, cfg, key, started):
+    """The folder of ``cfg``'s run file holds a run already: return it complete, resume it,
+    or refuse it (:class:`ConfigError` on ``key``)."""
     try:
         stored, reason = stored_config(path, key)
     except ConfigError as error:
@@ -505,9 +512,9 @@ def resume(path, overrides=()):
 def _apply(stored, overrides):
     """``stored`` with ``overrides`` applied; keys outside :data:`RESUMABLE` are refused."""
     keys = [item.partition("=")[0].lstrip("+~") for item in overrides]
-    fixed = [key for key in keys if key not in RESUMABLE]
+    fixed = [k for k, key in enumerate(keys) if key not in RESUMABLE]
     if fixed:
-        raise ConfigError(fixed[0], OmegaConf.select(stored, fixed[0], default=None),
+        raise ConfigError(keys[fixed[0]], overrides[fixed[0]].partition("=")[2],
                           f"unchanged on resume (it would change what the run file "
                           f"holds); a resume may change {', '.join(RESUMABLE)}")
     try:
@@ -526,13 +533,16 @@ def _resume_locked(path, stored, reason, overrides, started):
     cfg = _apply(stored, overrides)
     validate(cfg)
     differ = differences(stored, cfg)
-    changed = [item for item in overrides if item.partition("=")[0].lstrip("+~") in differ]
+    recorded = [item for item in overrides if item.partition("=")[0].lstrip("+~") in differ]
+    changed = [item for item in recorded if item.partition("=")[0].lstrip("+~") not in COSMETIC]
     with h5py.File(path, "r") as f:
         checkpointed = "checkpoint" in f and "latest" in f["checkpoint"].attrs
         made_by = yaml.safe_load(str(f["parameters"].attrs.get("overrides", "[]"))) or []
     if not checkpointed:  # a file of a run that never reached its first checkpoint
+        engine = build_engine(cfg)
+        check_reachable(cfg, engine)
         path.unlink()
-        return _new_run(path, build_engine(cfg), cfg, made_by, started)
+        return _new_run(path, engine, cfg, made_by, started)
     if reason in FINISHED and not changed:
         log.info("%s is complete (stopped by %s); nothing to resume", path, reason)
         return path
@@ -540,7 +550,7 @@ def _resume_locked(path, stored, reason, overrides, started):
     observers = observers_from_config(cfg, engine)  # they remember the start of the run
     try:  # read-only: a refusal leaves the file as it was
         with h5py.File(path, "r") as f:
-            state, last_time, snapshots = read_checkpoint(f)
+            state, last_time, snapshots, slot = read_checkpoint(f)
         engine.load_state_dict(state)
     except UnreadableRunFile as error:  # both checkpoints damaged
         raise ConfigError("resume", str(path), "a run file with an intact checkpoint; "
@@ -550,15 +560,22 @@ def _resume_locked(path, stored, reason, overrides, started):
                           f"{' '.join(str(error).split())}") from error
     met = already_met(engine, cfg)
     if met is not None:
-        if changed:
+        keys = [item.partition("=")[0].lstrip("+~") for item in changed]
+        if met[0] in keys:
             raise ConfigError(*met)
+        if keys:
+            raise ConfigError(keys[0], OmegaConf.select(cfg, keys[0]),
+                              f"a change to a run that is complete ({met[0]}={met[1]} holds "
+                              f"already); raise a stop condition to continue it")
         log.info("%s is complete; nothing to resume", path)
         return path
+    check_reachable(cfg, engine)
+    next_snapshot_time(last_time, cfg.output.every_time)
     writer = _writer(path, engine, cfg, mode="r+", observers=observers)
 
     def from_the_checkpoint(interruption):
-        writer.truncate(snapshots, engine.events)
-        writer.record_resume(OmegaConf.to_yaml(cfg, resolve=True), snapshots, changed)
+        writer.truncate(snapshots, engine.events, slot)
+        writer.record_resume(OmegaConf.to_yaml(cfg, resolve=True), snapshots, recorded)
         return advance(engine, cfg, writer, last_time, started, interruption)
 
     _record(writer, engine, from_the_checkpoint)

@@ -3,7 +3,8 @@ met already, and conditions a scene can never meet.
 
 A run ends at the first of its conditions that holds (``stop:`` in the config). A condition
 on disk–disk collisions in a scene whose disks can never touch, on contacts in a periodic box
-of disks that never meet, or on kinetic energy in a scene that conserves it would never hold;
+of disks that never meet, on the energy contacts dissipate where none can, or on a kinetic
+energy that never changes would never hold;
 when every condition of a scene is of that kind, :func:`check_reachable` refuses the scene
 before any work. (A scene in which nothing moves at all ends by itself: the engine then has
 no event left, stop reason ``no_events``.)
@@ -62,6 +63,9 @@ def _disks_never_touch(engine):
             or engine.wall_temperature is not None or engine.n > PAIRWISE_LIMIT:
         return False
     position, velocity = engine.positions(), engine.velocities()
+    one_velocity = np.all(engine.periodic) and np.all(velocity == velocity[0])
+    if np.any(np.all(velocity != 0.0, axis=1)) and not one_velocity:
+        return False  # a disk moving along no axis may meet any other: no pairs to test
     radius = engine.radius
     pairs = np.triu_indices(engine.n, 1)
     sigma = radius[pairs[0]] + radius[pairs[1]]
@@ -84,6 +88,13 @@ def _conserves_kinetic_energy(engine):
             and engine.wall_temperature is None)
 
 
+def _dissipates(engine, never_touch):
+    """Whether any contact can lose energy: inelastic disks that can meet, or inelastic walls
+    in a box that has walls (the engine's energy fraction counts what contacts dissipate)."""
+    return ((engine.restitution is not None and not never_touch)
+            or (engine.wall_restitution is not None and not np.all(engine.periodic)))
+
+
 def check_reachable(cfg, engine):
     """Refuse (:class:`ConfigError` on ``stop``) a scene none of whose stop conditions can
     ever hold for the initial state of ``engine``; see the module docstring."""
@@ -100,11 +111,11 @@ def check_reachable(cfg, engine):
                                   else "these disks never touch one another")
     if s.events is not None and never_touch and np.all(engine.periodic):
         why["stop.events"] = "a periodic box has no walls and these disks never touch"
-    conserved = _conserves_kinetic_energy(engine)
-    if s.energy_fraction is not None and s.energy_fraction < 1.0 and conserved:
-        why["stop.energy_fraction"] = "the kinetic energy never changes (elastic, no " \
-                                      "gravity, no moving or thermal walls)"
-    if s.at_rest is not None and conserved and engine.n_species == 1:
+    if s.energy_fraction is not None and s.energy_fraction < 1.0 \
+            and not _dissipates(engine, never_touch):
+        why["stop.energy_fraction"] = "no contact dissipates energy (elastic disks and walls, " \
+                                      "or inelastic disks that never meet)"
+    if s.at_rest is not None and _conserves_kinetic_energy(engine) and engine.n_species == 1:
         why["stop.at_rest"] = "the kinetic energy never changes"
     given = [key for key in ("collisions", "events", "energy_fraction", "at_rest")
              if s[key] is not None]
