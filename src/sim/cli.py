@@ -428,19 +428,30 @@ def _warn_in_one_line(message, category, filename, lineno, file=None, line=None)
     print(f"sim: warning: {' '.join(str(message).split())}", file=sys.stderr, flush=True)
 
 
+def _failed_hdf5_write(error):
+    return isinstance(error, (OSError, RuntimeError)) and "write failed" in str(error)
+
+
 def _quiet_hdf5_teardown(unraisable):
-    """HDF5 tries a failed write again as it releases the objects of that file, and h5py
-    prints each failure; the run has reported the failure in one line already."""
-    if isinstance(unraisable.exc_value, RuntimeError) and \
-            "write failed" in str(unraisable.exc_value):
-        return
-    sys.__unraisablehook__(unraisable)
+    """HDF5 tries a failed write again as it releases the objects of that file (a dataset
+    closed after a write it could not finish, wherever the writer's wall-clock flush left
+    it), and h5py reports each failure: its traceback through ``sys.excepthook``, then
+    "Exception ignored" through ``sys.unraisablehook``. The run reports the failure in one
+    line; both hooks pass these over."""
+    if not _failed_hdf5_write(unraisable.exc_value):
+        sys.__unraisablehook__(unraisable)
+
+
+def _quiet_hdf5_traceback(kind, error, traceback):
+    if not _failed_hdf5_write(error):
+        sys.__excepthook__(kind, error, traceback)
 
 
 def main():
     """The command line's entry point (see the module docstring)."""
     signal.signal(signal.SIGTERM, _terminate)  # before the run: SIGTERM as Ctrl-C
     sys.unraisablehook = _quiet_hdf5_teardown
+    sys.excepthook = _quiet_hdf5_traceback
     warnings.showwarning = _warn_in_one_line
     Interruption.at_second_signal = _stop_at_once
     args = whole_numbers(sys.argv[1:])
