@@ -193,6 +193,17 @@ def test_the_sweep_command_writes_two_run_files(tmp_path):
     assert [c["projectile"]["radius"] for c in configs] == [0.01, 0.02]
 
 
+def test_snapshots_in_time_lie_on_their_grid_and_end_once(tmp_path):
+    """Snapshot times are k Δt, not sums of Δt: a hundred steps of 0.4 end at stop.time = 40
+    with one snapshot there, none a round-off before it."""
+    path = runner.run(compose_scene("gas", "stop.collisions=null", "stop.time=40",
+                                    "output.every_collisions=null", "output.every_time=0.4",
+                                    "disks.n=50", "disks.speed=0.01"), tmp_path)
+    with open_run(path) as ds:
+        time = ds["time"].values
+    np.testing.assert_array_equal(time, np.arange(101) * 0.4)
+
+
 def test_at_rest_stops_once_every_species_has_lost_its_energy(tmp_path):
     path = runner.run(compose_scene("crater", "stop.energy_fraction=null", "stop.at_rest=0.3",
                                     "stop.collisions=10000000"), tmp_path)

@@ -182,14 +182,21 @@ def every_collisions(cfg, n):
 
 
 def next_snapshot_time(last_time, every_time):
-    """``last_time + every_time`` (None without a cadence in time), or :class:`ConfigError`
-    once float64 cannot tell the two apart (a long run, a short cadence)."""
+    """The first point k Δt of the snapshot grid after ``last_time`` (Δt = ``every_time``;
+    None without a cadence in time), or :class:`ConfigError` once float64 cannot tell it from
+    ``last_time`` (a long run, a short cadence). Grid points are multiples, never sums, so
+    that round-off neither drifts them nor puts a snapshot a round-off before a stop.time
+    on the grid; a ``last_time`` within a few ulps of a grid point is on it."""
     if every_time is None:
         return None
-    if last_time + every_time <= last_time:
+    k = last_time / every_time
+    nearest = round(k)
+    on_grid = abs(k - nearest) <= 8.0 * np.finfo(float).eps * max(1.0, abs(k))
+    next_time = ((nearest if on_grid else math.floor(k)) + 1) * every_time
+    if next_time <= last_time:
         raise ConfigError("output.every_time", every_time,
                           f"a cadence that float64 can add to t = {last_time:.6g}")
-    return last_time + every_time
+    return next_time
 
 
 def advance(engine, cfg, writer, last_time, started, interruption):
