@@ -7,9 +7,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sim.crater import calibrated_spacing, crater_area, occupied_cells
+from sim.analysis import open_run
+from sim.crater import CraterGeometry, area, calibrated_spacing, crater_area, occupied_cells
 from sim.engine import Engine
+from sim.figures.runs import compose_config
 from sim.initial import hexagonal_lattice
+from sim.runner import run
 
 
 def overlaps_by_figure_1(cx, cy, radius, x0, y0, x1, y1):
@@ -82,3 +85,20 @@ def test_a_crater_at_twice_the_speed_is_the_same_crater_in_half_the_time():
     np.testing.assert_array_equal(slow.positions(), fast.positions())
     np.testing.assert_array_equal(2.0 * slow.velocities(), fast.velocities())
     assert fast.dissipated_energy == 4.0 * slow.dissipated_energy
+
+
+def test_the_area_of_a_run_in_one_call(tmp_path):
+    """sim.crater.area(path) is the area of the last snapshot on the grid calibrated on the
+    first, and the same from an open Dataset; the first snapshot's bed has no crater."""
+    cfg = compose_config(["scenario=crater", "bed.n=300", "bed.radius=0.016",
+                          "stop.collisions=3000", "output.every_collisions=1000",
+                          "output.progress=false"])
+    path = run(cfg, tmp_path)
+    with open_run(path) as ds:
+        geometry = CraterGeometry.of_run(ds)
+        last = ds["position"].isel(time=-1).values
+        assert area(ds) == geometry.area(last) > 0.0
+        assert area(ds, snapshot=0) == 0.0
+        assert "melted" in ds.attrs["preparation"]
+    assert area(path) == geometry.area(last)
+    assert area(path, dx=geometry.dx / 2) == geometry.area(last, geometry.dx / 2)

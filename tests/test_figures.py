@@ -16,11 +16,14 @@ def test_quick_figures(tmp_path):
                  "fig11_crater_gravity"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
-    x, y, energy = path[:, 2], path[:, 3], path[:, 4]
+    x, y, distance, energy = path[:, 2], path[:, 3], path[:, 4], path[:, 5]
     radius = 0.05
-    # every snapshot on the tilted rectangle |x − 1/2| + |y − 1/2| = 1/2 − R
+    # every snapshot on the tilted rectangle |x − 1/2| + |y − 1/2| = 1/2 − R, and the
+    # distance the figure draws is the distance from it
     np.testing.assert_allclose(np.abs(x - 0.5) + np.abs(y - 0.5), 0.5 - radius, atol=1e-9)
-    assert np.all(energy == energy[0])
+    np.testing.assert_allclose(distance, np.abs(np.abs(x - 0.5) + np.abs(y - 0.5)
+                                                - (0.5 - radius)) / np.sqrt(2), rtol=1e-6)
+    assert np.all(energy == energy[0])  # elastic walls only reverse a component
     scattering = np.loadtxt(out / "fig03_scattering.csv", delimiter=",", skiprows=1)
     np.testing.assert_allclose(scattering[:, 2], scattering[:, 3], atol=1e-9)
     mb = dict(line.split("=") for line in
@@ -28,20 +31,25 @@ def test_quick_figures(tmp_path):
     assert float(mb["ks_pvalue"]) > 1e-3
     assert 0 < float(mb["equilibration_collisions"]) < 10 * 1000
     two = dict(line.split("=") for line in (out / "fig02_two_disks.txt").read_text().split())
-    assert (out / "fig02_two_disks.gif").stat().st_size > 10_000
     # the measured loss of order agrees with ln(R / 1e-12) / ln(growth per collision)
     assert float(two["order_lost_after_collisions"]) == pytest.approx(
         float(two["estimate_collisions"]), abs=3)
     mixture = np.loadtxt(out / "fig06_mixture.csv", delimiter=",", skiprows=1)
     assert np.all(mixture[:, 2] > 1e-3)  # both species Maxwellian at the common T
+    # restitution, Garzó–Dufty ratio, measured ratio, its standard error, runs, L_c (ξ rising)
     cooling = np.loadtxt(out / "fig07_mixture_cooling.csv", delimiter=",", skiprows=1)
-    assert cooling[0, 2] == pytest.approx(1.0, abs=0.15)  # ξ = 1: equipartition
-    assert np.all(np.diff(cooling[:, 2]) > 0)  # the ratio grows as ξ falls, as predicted
+    assert np.all(np.diff(cooling[:, 0]) > 0) and cooling[-1, 0] == 1.0
+    assert np.all(np.diff(cooling[:, 2]) < 0)  # the ratio grows as ξ falls, as predicted
+    # within five standard errors of the theory (four runs of 800 disks; the theory's own
+    # error, below 1 %, is inside that) and every box below the instability length
+    assert np.all(np.abs(cooling[:, 2] - cooling[:, 1]) < 5 * cooling[:, 3] + 0.01)
+    assert np.all(cooling[:, 5] > 1.0)
     grid = np.loadtxt(out / "fig08_crater_grid.csv", delimiter=",", skiprows=1)
     assert np.all(grid[:, 2] > np.pi * 0.05**2)  # the crater is larger than the projectile
     assert np.all(grid[:, 2] < 0.5)  # and smaller than the bed
     radius = np.loadtxt(out / "fig09_crater_radius.csv", delimiter=",", skiprows=1)
     assert np.all(np.diff(radius[:, 2]) > 0)  # larger projectiles dig larger craters
+    assert radius[0, 4] == 0  # the smallest projectile stays far above the floor
     speed = np.loadtxt(out / "fig10_crater_speed.csv", delimiter=",", skiprows=1)
     # no energy scale: the same area at every speed, but for the TC model's fixed t_c, which
     # makes each speed's run another realization: at one speed the area scatters by 4.7 %
@@ -56,6 +64,8 @@ def test_quick_figures(tmp_path):
     opened = gravity[:, 2] > np.pi * 0.05**2
     assert opened.sum() >= 2
     assert np.all(gravity[opened, 3] < 0.5 * gravity[opened, 2])
+    for movie in ("two_disks", "crater", "cooling"):
+        assert (out / f"movie_{movie}.mp4").stat().st_size > 10_000
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
     main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])

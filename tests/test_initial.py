@@ -1,5 +1,6 @@
 """Initial states: placement without overlap, where asked, reproducibly; velocity laws."""
 
+import freud
 import numpy as np
 import pytest
 from scipy import stats
@@ -10,6 +11,7 @@ from sim.initial import (
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
+    melted_lattice,
     random_sequential,
     remove_drift,
 )
@@ -44,6 +46,32 @@ def test_lattice_in_a_region_with_jitter():
     assert overlapping_pairs(position, radius, tolerance=0.0)[0].size == 0
     assert position[:, 1].max() <= 0.5 - radius and position[:, 1].min() >= radius
     assert np.unique(np.round(position[:, 1], 6)).size > 100  # jittered, not bare rows
+
+
+def global_bond_order(position, region):
+    """|⟨ψ₆⟩| over the disks of a walled region ((x0, x1), (y0, y1)), from freud (the test's
+    oracle), six nearest neighbours; the region is set in a box twice its size so that no
+    neighbour is found across a wall."""
+    (x0, x1), (y0, y1) = region
+    box = freud.box.Box(Lx=2 * (x1 - x0), Ly=2 * (y1 - y0), is2D=True)
+    points = np.column_stack([position[:, 0] - x1, position[:, 1] - y1, np.zeros(len(position))])
+    hexatic = freud.order.Hexatic(k=6)
+    hexatic.compute((box, points), neighbors={"num_neighbors": 6})
+    return float(np.abs(hexatic.particle_order.mean()))
+
+
+def test_melted_lattice_is_a_fluid_without_overlap():
+    """The crater bed's packing (φ = 0.51 in the lower half of the box): the jittered lattice
+    is a crystal (|ψ₆| ≈ 0.9); melted, its global order is a fluid's, within three times the
+    1/√n of uncorrelated bond angles, and no disk overlaps another or a wall."""
+    n, radius, region = 4000, 0.0045, ((0.0, 1.0), (0.0, 0.5))
+    crystal = hexagonal_lattice(n, radius, region=region, seed=5)
+    fluid = melted_lattice(n, radius, region=region, seed=5)
+    assert global_bond_order(crystal, region) > 0.8
+    assert global_bond_order(fluid, region) < 3.0 / np.sqrt(n)
+    assert overlapping_pairs(fluid, np.full(n, radius), tolerance=0.0)[0].size == 0
+    assert fluid[:, 1].max() <= 0.5 - radius and fluid.min() >= radius
+    np.testing.assert_array_equal(fluid, melted_lattice(n, radius, region=region, seed=5))
 
 
 def test_lattice_error_names_the_limit():

@@ -54,6 +54,7 @@ def test_local_fields_add_up_to_the_whole_gas(tmp_path):
     with open_run(run(cfg, tmp_path)) as ds:
         fields = ds["local_fields"]
         assert fields.dims == ("time", "field", "y", "x") and fields.sizes["x"] == 8
+        assert fields["field"].values.tolist() == ["packing_fraction", "temperature"]
         n = ds.sizes["disk"]
         position = ds["position"].isel(time=-1).values
         energy = float(ds["kinetic_energy"].values[-1])
@@ -135,6 +136,7 @@ def test_pressure_tensor_is_isotropic_and_its_trace_is_the_pressure(tmp_path):
     with periodic_gas(tmp_path, "observe.pressure_tensor=true", "stop.collisions=400000",
                       "output.every_collisions=20000") as ds:
         tensor = ds["collision_virial_tensor"].values
+        assert ds["collision_virial_tensor"]["a"].values.tolist() == ["x", "y"]
         np.testing.assert_allclose(tensor[:, 0, 0] + tensor[:, 1, 1], ds["collision_virial"],
                                    rtol=1e-12)
         pressure = pressure_tensor(ds).isel(time=slice(2, None)).mean("time").values

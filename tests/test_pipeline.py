@@ -204,6 +204,28 @@ def test_snapshots_in_time_lie_on_their_grid_and_end_once(tmp_path):
     np.testing.assert_array_equal(time, np.arange(101) * 0.4)
 
 
+def test_inspect_names_the_boundary_and_the_observables(tmp_path):
+    path = runner.run(compose_scene("gas", "stop.collisions=500", "walls.bottom.temperature=2",
+                                    "observe.clusters.gap=0.1"), tmp_path)
+    info = summary(path)
+    assert info["boundary"] == "x: walls, y: walls (bottom thermal at T = 2)"
+    assert {"clusters", "kinetic_energy", "collisions"} <= set(info["observables"])
+
+
+def test_open_sweep_pads_shorter_runs_and_keeps_counters_integer(tmp_path):
+    for k, collisions in enumerate((1500, 3000)):
+        overrides = [f"stop.collisions={collisions}"]
+        runner.run(compose_scene("gas", *overrides, "output.every_collisions=500"),
+                   tmp_path / "sweep" / str(k), overrides=overrides)
+    sweep = open_sweep(tmp_path / "sweep")
+    assert sweep.attrs["swept"] == ["stop_collisions"]
+    collisions = sweep["collisions"]
+    assert collisions.dtype.kind == "i"
+    np.testing.assert_array_equal(collisions.sel(stop_collisions=1500)[-3:], [-1, -1, -1])
+    assert collisions.sel(stop_collisions=3000).values[-1] == 3000
+    assert np.isnan(sweep["kinetic_energy"].sel(stop_collisions=1500)[-1])
+
+
 def test_at_rest_stops_once_every_species_has_lost_its_energy(tmp_path):
     path = runner.run(compose_scene("crater", "stop.energy_fraction=null", "stop.at_rest=0.3",
                                     "stop.collisions=10000000"), tmp_path)

@@ -35,8 +35,9 @@ from matplotlib.ticker import NullFormatter
 from scipy import stats
 
 from sim.analysis import open_run
+from sim.crater import CraterGeometry
 from sim.engine import Boundary, Engine, InelasticCollapseError
-from sim.figures.crater_runs import CraterGeometry, crater_overrides
+from sim.figures.crater_runs import crater_overrides
 from sim.figures.runs import compose_config, ensure_run
 from sim.initial import (
     fixed_speed,

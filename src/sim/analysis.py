@@ -7,14 +7,17 @@ Datasets that the figure stages read; nothing here simulates.
 and the observables (``kinetic_energy``, ``kinetic_energy_by_species``, ``collisions``,
 ``wall_collisions``, ``dissipated_energy``, ``collision_virial``, and those of the scene's
 observers, e.g. ``radial_distribution`` over ``r``, ``clusters`` over ``disk``,
-``local_fields`` over ``field``, ``y``, ``x``); per-disk coordinates
-``radius``, ``mass``, ``species_id``; attributes: scene, seed, the resolved config (YAML), stop
-reason, box edges and boundary.
+``local_fields`` over ``field`` (``packing_fraction``, ``temperature``), ``y``, ``x``, the
+tensors over ``a``, ``b`` (each ``x``, ``y``)); per-disk coordinates
+``radius``, ``mass``, ``species_id``; attributes: scene, seed, the resolved config (YAML), how
+the initial state was made (``preparation``), stop reason, box edges and boundary.
 
 ``open_sweep(multirun_dir)``: the runs of a Hydra sweep in one Dataset with each swept
 parameter as a dimension (``projectile.radius`` → ``projectile_radius``); runs are aligned by
-snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate; each run's
-resolved config (YAML) and stop reason are the variables ``config`` and ``stop_reason``.
+snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate; a run with
+fewer snapshots than another is padded with NaN, and its integer counters (``collisions``,
+``wall_collisions``) with −1, so that they stay integers; each run's resolved config (YAML)
+and stop reason are the variables ``config`` and ``stop_reason``.
 """
 
 import warnings
@@ -89,6 +92,11 @@ def _needed(path, dataset):
                            f"it") from error
 
 
+def _coordinate(values):
+    """An observer's coordinate as stored: numbers, or names (bytes in HDF5) as str."""
+    return values.astype(str) if values.dtype.kind == "S" else values
+
+
 def open_run(path):
     """The run file at ``path`` as an :class:`xarray.Dataset` (see the module docstring).
     Close it with ``ds.close()`` (or use it in a ``with`` block) to release the file.
@@ -115,7 +123,7 @@ def open_run(path):
                 dims = ("time",)
             else:  # an observer's: its dims as an attribute, coordinates beside its value
                 dims = ("time", *(str(d) for d in group.attrs["dims"]))
-                axes.update({k: _needed(path, group[k]) for k in group
+                axes.update({k: _coordinate(_needed(path, group[k])) for k in group
                              if k not in ("step", "time", "value")})
             values, frames = read_intact(group["value"])
             if frames:
@@ -128,6 +136,7 @@ def open_run(path):
             config = yaml.safe_load(parameters["config"])
             attrs = {"scene": config.get("scene", ""), "seed": int(parameters["seed"]),
                      "config": str(parameters["config"]),
+                     "preparation": str(parameters.get("preparation", "")),
                      "stop_reason": str(parameters["stop_reason"])}
         except (*DAMAGE, yaml.YAMLError, AttributeError) as error:
             raise RunFileError(f"{path}: /parameters is damaged ({' '.join(str(error).split())})"
@@ -190,6 +199,9 @@ def _parsed(text):
 
 _MISSING = object()
 
+#: an integer counter of a snapshot that a run of a sweep does not have
+NOT_REACHED = -1
+
 
 def open_sweep(multirun_dir):
     """The runs of a sweep directory in one Dataset, one dimension per swept parameter: the
@@ -210,14 +222,17 @@ def open_sweep(multirun_dir):
         reasons.append(ds.attrs.pop("stop_reason"))
         datasets.append(ds.expand_dims({k.replace(".", "_"): [override[k]]
                                         for k in swept}))
+    fill = {name: NOT_REACHED for name, variable in datasets[0].data_vars.items()
+            if variable.dtype.kind in "iu"}
     if not swept:
         combined = xr.concat(datasets, dim="run", join="outer", data_vars="all",
-                             coords="different", compat="equals")
+                             coords="different", compat="equals", fill_value=fill)
         combined["config"] = ("run", np.array(configs, dtype=object))
         combined["stop_reason"] = ("run", np.array(reasons, dtype=object))
         return combined
     combined = xr.combine_by_coords(datasets, join="outer", combine_attrs="drop_conflicts",
-                                    data_vars="all", coords="different", compat="no_conflicts")
+                                    data_vars="all", coords="different", compat="no_conflicts",
+                                    fill_value=fill)
     dims = [k.replace(".", "_") for k in swept]
     for name, texts in (("config", configs), ("stop_reason", reasons)):
         per_run = xr.DataArray(np.empty([combined.sizes[d] for d in dims], dtype=object),
@@ -286,7 +301,8 @@ def pressure_tensor(run):
         "time", label="upper")
     tensor = (kinetic.isel(time=slice(None, -1)).values + rate.values) / area
     return xr.DataArray(tensor, dims=("time", "a", "b"),
-                        coords={"time": rate["time"].values, "a": [0, 1], "b": [0, 1]},
+                        coords={"time": rate["time"].values, "a": ["x", "y"],
+                                "b": ["x", "y"]},
                         attrs={"unit": "energy/area"})
 
 

@@ -388,8 +388,8 @@ def validate(cfg: Any) -> None:
                           "give disks.speed or disks.temperature (set the other to null)")
     _positive(c, "disks.speed", d.speed, zero=True)
     _positive(c, "disks.temperature", d.temperature, zero=True)
-    if d.placement not in ("random", "lattice", "auto"):
-        raise ConfigError("disks.placement", d.placement, "random, lattice or auto")
+    if d.placement not in ("random", "lattice", "melted", "auto"):
+        raise ConfigError("disks.placement", d.placement, "random, lattice, melted or auto")
     if d.placement == "random" and c.scene in ("gas", "mixture", "cooling"):
         area = float(c.box.size[0]) * float(c.box.size[1])
         phi = (d.packing_fraction if d.radius is None
@@ -397,7 +397,7 @@ def validate(cfg: Any) -> None:
         if phi is not None and phi > RSA_JAMMING:
             raise ConfigError("disks.packing_fraction", round(phi, 4),
                               f"random placement reaches at most φ ≈ {RSA_JAMMING}; use "
-                              f"disks.placement=lattice or auto")
+                              f"disks.placement=melted or auto")
     _within("restitution.disk", c.restitution.disk, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
     _within("restitution.wall", c.restitution.wall, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
     _positive(c, "tc.time", c.tc.time, zero=True)

@@ -9,9 +9,15 @@ rounded corners, i.e. when the distance from c to the nearest point of the squar
 
 Positions, radii and Δx in box units; the grid starts at the box origin, so a bed height
 that is a multiple of Δx is a grid line.
+
+From a run in one call: ``sim.crater.area("run.h5")`` (the area at the last snapshot, Δx
+calibrated on the untouched bed); :class:`CraterGeometry` for more snapshots or spacings.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
+import yaml
 
 
 def occupied_cells(position, radius, dx, extent):
@@ -61,3 +67,46 @@ def calibrated_spacing(position, radius, width, bed_height):
                                      bed_height)[0] == 0:
         k += 1
     return bed_height / k
+
+
+@dataclass
+class CraterGeometry:
+    """What the crater measure needs from a run: the bed disks, the bed region and the grid
+    spacing calibrated on the untouched bed (:func:`calibrated_spacing`)."""
+
+    bed: np.ndarray  # bool[n], True for bed disks (species 0)
+    radius: np.ndarray  # radii of the bed disks
+    width: float
+    height: float
+    dx: float
+
+    @classmethod
+    def of_run(cls, ds):
+        """From one run's Dataset: :func:`sim.analysis.open_run`'s, or one run selected from
+        :func:`sim.analysis.open_sweep`'s."""
+        bed = np.asarray(ds["species_id"].values == 0)
+        radius = np.asarray(ds["radius"].values[bed])
+        config = ds["config"].item() if "config" in ds else ds.attrs["config"]
+        height = float(yaml.safe_load(config)["bed"]["height"])
+        width = float(ds.attrs["box"][0])
+        snapshot_dim = "snapshot" if "snapshot" in ds.dims else "time"
+        first = np.asarray(ds["position"].isel({snapshot_dim: 0}).values)[bed]
+        return cls(bed, radius, width, height, calibrated_spacing(first, radius, width, height))
+
+    def area(self, position, dx=None):
+        """Crater area (box units²) of one snapshot's positions float64[n, 2]."""
+        return crater_area(position[self.bed], self.radius, dx or self.dx, self.width,
+                           self.height)[0]
+
+
+def area(run, snapshot=-1, dx=None):
+    """Crater area (box units²) of a crater run at ``snapshot`` (default the last): ``run`` a
+    run-file path or an :func:`sim.analysis.open_run` Dataset; Δx calibrated on the run's
+    untouched bed unless given."""
+    from sim.analysis import open_run  # the measure itself needs no run file
+
+    if not hasattr(run, "attrs"):
+        with open_run(run) as ds:
+            return area(ds, snapshot, dx)
+    geometry = CraterGeometry.of_run(run)
+    return geometry.area(np.asarray(run["position"].isel(time=snapshot).values), dx)

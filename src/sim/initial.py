@@ -5,6 +5,9 @@
   J. Stat. Phys. 44, 793 (1986)), so denser packings need :func:`hexagonal_lattice`.
 * :func:`hexagonal_lattice` — triangular lattice up to φ = π/(2√3) ≈ 0.907 with a small random
   displacement that never creates an overlap.
+* :func:`melted_lattice` — that lattice melted by an elastic run of its own: a random, fluid
+  arrangement at packings random addition cannot reach (equal hard disks are fluid below
+  φ ≈ 0.70; Bernard & Krauth, Phys. Rev. Lett. 107, 155704 (2011)).
 * :func:`fixed_speed` (equal speeds, random directions, as the seed study) and
   :func:`maxwellian` (components drawn from N(0, T/m)); :func:`remove_drift` zeroes the total
   momentum.
@@ -190,6 +193,33 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
     # a clipped coordinate moves the disk back towards its site: still no overlap
     clipped = np.clip(position, lo + r_max, hi - r_max)
     return np.where(wraps, position % np.asarray(box, float), clipped)
+
+
+#: Collisions per disk of the elastic run that melts a lattice (:func:`melted_lattice`): at
+#: φ = 0.51 the global bond-orientational order |ψ₆| falls from 0.9 to the noise of a fluid
+#: (≲ 3/√n) within about 5, and tests/test_initial.py checks it at this count.
+MELT_COLLISIONS_PER_DISK = 20
+
+
+def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, False), seed=0,
+                   collisions_per_disk=MELT_COLLISIONS_PER_DISK):
+    """Positions float64[n, 2] of n disks placed on :func:`hexagonal_lattice` and melted by
+    an elastic run confined to the region (Maxwellian velocities at T = 1, zero momentum,
+    ``collisions_per_disk`` collisions per disk, i.e. n × collisions_per_disk / 2 disk–disk
+    collisions): hard walls at the region's edges, periodic along an axis the region spans
+    in a periodic box. Deterministic in ``seed``."""
+    from sim.engine import Boundary, Engine  # the engine prepares, it does not place
+
+    lo, hi = _region(region, box)
+    wraps = tuple(bool(periodic[a]) and lo[a] == 0.0 and hi[a] == box[a] for a in range(2))
+    position = hexagonal_lattice(n, radius, box=box, region=region, periodic=periodic, seed=seed)
+    mass = np.ones(n)
+    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
+    engine = Engine(position - lo, velocity, radius, mass,
+                    boundary=Boundary(size=tuple(float(x) for x in hi - lo), periodic=wraps),
+                    seed=seed)
+    engine.run(collisions=round(0.5 * collisions_per_disk * n))
+    return engine.positions() + lo
 
 
 def fixed_speed(n, speed, seed=0):

@@ -256,7 +256,8 @@ def summary(path, verify=True):
                 "scene": config.get("scene"),
                 "n": int(f["particles/disks/radius"].shape[0]),
                 "species": None if np.isnan(species).any() else int(np.max(species) + 1),
-                "boundary": [b.decode() for b in f["particles/disks/box"].attrs["boundary"]],
+                "boundary": _boundary(f["particles/disks/box"].attrs["boundary"], config),
+                "observables": sorted(f["observables"]),
                 "snapshots": int(time.size),
                 "time_span": [_at(time, 0), _at(time, -1)] if time.size else None,
                 "collisions": _at(collisions, -1) if collisions.size else 0,
@@ -283,6 +284,24 @@ def summary(path, verify=True):
         result["energy_drift"] = None  # no snapshot has every energy intact
     result.update(checksums=checksums, damaged=damaged)
     return result
+
+
+def _boundary(kinds, config):
+    """The box's edges in words: ``periodic`` or ``walls`` along x and y (H5MD writes a walled
+    axis as ``none``), then every wall that is not a plain hard wall."""
+    axes = [f"{axis}: {'periodic' if kind.decode() == 'periodic' else 'walls'}"
+            for axis, kind in zip("xy", kinds, strict=True)]
+    special = []
+    walled = any(kind.decode() != "periodic" for kind in kinds)
+    for name, wall in (config.get("walls") or {}).items() if walled else ():
+        if wall.get("temperature") is not None:
+            special.append(f"{name} thermal at T = {wall['temperature']:g}")
+        if wall.get("speed"):
+            special.append(f"{name} moving at {wall['speed']:g}")
+        if wall.get("amplitude"):
+            special.append(f"{name} oscillating, amplitude {wall['amplitude']:g}, "
+                           f"ω = {wall['frequency']:g}")
+    return ", ".join(axes) + (f" ({'; '.join(special)})" if special else "")
 
 
 CHECKSUMS = {"all": "on every dataset (fletcher32)",

@@ -112,9 +112,10 @@ class LocalFields:
         self.cells = (cells, max(1, round(cells * ly / lx)))
         self.width = (lx / self.cells[0], ly / self.cells[1])
         self.shape = (2, self.cells[1], self.cells[0])
-        self.coords = {"x": (np.arange(self.cells[0]) + 0.5) * self.width[0],
+        self.coords = {"field": np.array([b"packing_fraction", b"temperature"]),
+                       "x": (np.arange(self.cells[0]) + 0.5) * self.width[0],
                        "y": (np.arange(self.cells[1]) + 0.5) * self.width[1]}
-        self.description = ("packing fraction (field 0) and granular temperature (field 1) on "
+        self.description = ("packing fraction and granular temperature (./field) on "
                             f"{self.cells[0]} × {self.cells[1]} cells; cell centres in ./x, ./y")
         self.disk_area = np.pi * np.asarray(engine.radius, dtype=np.float64) ** 2
         self.mass = np.asarray(engine.mass, dtype=np.float64)
@@ -201,7 +202,7 @@ class KineticTensor:
     dtype = np.float64
     shape = (2, 2)
     dims = ("a", "b")
-    coords = {"a": np.array([0, 1]), "b": np.array([0, 1])}
+    coords = {"a": np.array([b"x", b"y"]), "b": np.array([b"x", b"y"])}
 
     def __init__(self, engine):
         self.mass = engine.mass

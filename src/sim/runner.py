@@ -41,7 +41,7 @@ from sim.inspect import RunFileError as UnreadableRunFile
 from sim.inspect import open_run_file
 from sim.observers import from_config as observers_from_config
 from sim.run_folder import FolderBusyError, RunLock, part_path, publish
-from sim.scenes import build_scene
+from sim.scenes import build_scene, preparation
 from sim.stop_conditions import already_met, at_rest, check_reachable
 
 log = logging.getLogger(__name__)
@@ -122,12 +122,12 @@ def _git_commit():
 
 
 def parameters(cfg, overrides=()):
-    """What /parameters records: the resolved config, the overrides that made it, seed,
-    versions, commit."""
+    """What /parameters records: the resolved config, the overrides that made it, seed, how
+    the initial state was made, versions, commit."""
     import numba
 
     return {"config": OmegaConf.to_yaml(cfg, resolve=True), "seed": int(cfg.seed),
-            "overrides": yaml.safe_dump(list(overrides)),
+            "overrides": yaml.safe_dump(list(overrides)), "preparation": preparation(cfg),
             "versions": f"sim {sim.__version__}, python {sys.version.split()[0]}, numpy "
                         f"{np.__version__}, numba {numba.__version__}, h5py "
                         f"{h5py.__version__}",

@@ -1,8 +1,9 @@
 """Scenes: from a validated config to the initial state of the engine.
 
-Each scene is a function registered under its name (``@scene("crater")``) that returns a
-:class:`Scene`; adding a scene is adding a function here and a YAML file in
-``conf/scenario/``. Positions and velocities are float64[n, 2] in box units.
+Each scene is a function registered under its name (``@scene("crater", _bed_preparation)``)
+that returns a :class:`Scene`, with a function saying in words how it places its disks;
+adding a scene is adding them here and a YAML file in ``conf/scenario/``. Positions and
+velocities are float64[n, 2] in box units.
 """
 
 from dataclasses import dataclass
@@ -12,11 +13,13 @@ import numpy as np
 from sim.config import ConfigError
 from sim.engine import Boundary, Engine
 from sim.initial import (
+    MELT_COLLISIONS_PER_DISK,
     RSA_JAMMING,
     PlacementError,
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
+    melted_lattice,
     radius_for_packing,
     random_sequential,
     remove_drift,
@@ -35,12 +38,24 @@ class Scene:
     boundary: Boundary
 
 
-def scene(name):
-    """Register a scene builder ``f(cfg, rng_seed) -> Scene`` under ``name``."""
+#: scene name → ``f(cfg) -> str``: how the scene's initial state is made, in words
+PREPARATIONS = {}
+
+
+def scene(name, preparation=None):
+    """Register a scene builder ``f(cfg) -> Scene`` under ``name``, and ``preparation(cfg)``
+    saying how it places its disks (default: as the config gives them)."""
     def register(builder):
         BUILDERS[name] = builder
+        PREPARATIONS[name] = preparation or (lambda cfg: "positions and velocities as given")
         return builder
     return register
+
+
+def preparation(cfg):
+    """How the initial state of ``cfg``'s scene is made, in words (recorded in /parameters
+    as ``preparation`` and named on the figures)."""
+    return PREPARATIONS[cfg.scene](cfg)
 
 
 def build_scene(cfg):
@@ -65,27 +80,39 @@ def _gas_radius(cfg):
     return radius_for_packing(d.n, d.packing_fraction, area)
 
 
-def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):
-    """Random placement, or the lattice when asked or (auto) when random cannot reach φ;
-    a packing that cannot be placed is a :class:`ConfigError` on ``key``."""
+def _placement(cfg, n, radius, region=None):
+    """The placement ``disks.placement`` asks for, ``auto`` resolved: random addition where
+    it reaches the packing comfortably (φ < 0.8 × its jamming φ), else the melted lattice."""
+    if cfg.disks.placement != "auto":
+        return cfg.disks.placement
     box = (float(cfg.box.size[0]), float(cfg.box.size[1]))
-    boundary = _boundary(cfg)
-    placement = cfg.disks.placement
-    radii = np.full(n, radius)
-    if region is None:
-        area = box[0] * box[1]
-    else:
-        area = (region[0][1] - region[0][0]) * (region[1][1] - region[1][0])
-    phi = n * np.pi * radius**2 / area
-    if placement == "auto":
-        placement = "random" if phi < 0.8 * RSA_JAMMING else "lattice"
+    (x0, x1), (y0, y1) = region or ((0.0, box[0]), (0.0, box[1]))
+    phi = n * np.pi * radius**2 / ((x1 - x0) * (y1 - y0))
+    return "random" if phi < 0.8 * RSA_JAMMING else "melted"
+
+
+PLACEMENTS = {"random": "random sequential addition",
+              "lattice": "hexagonal lattice (jittered)",
+              "melted": f"hexagonal lattice melted by {MELT_COLLISIONS_PER_DISK} elastic "
+                        f"collisions per disk"}
+
+
+def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):
+    """Positions float64[n, 2] by :func:`_placement`; a packing that cannot be placed is a
+    :class:`ConfigError` on ``key``."""
+    box = (float(cfg.box.size[0]), float(cfg.box.size[1]))
+    periodic = _boundary(cfg).periodic
+    placement = _placement(cfg, n, radius, region)
     try:
         if placement == "random":
-            return random_sequential(radii, box=box, region=region,
-                                     periodic=boundary.periodic, seed=cfg.seed)
-        return hexagonal_lattice(n, radius, box=box, region=region, periodic=boundary.periodic,
-                                 seed=cfg.seed)
+            return random_sequential(np.full(n, radius), box=box, region=region,
+                                     periodic=periodic, seed=cfg.seed)
+        place = melted_lattice if placement == "melted" else hexagonal_lattice
+        return place(n, radius, box=box, region=region, periodic=periodic, seed=cfg.seed)
     except PlacementError as error:
+        area = (float(np.prod(box)) if region is None
+                else (region[0][1] - region[0][0]) * (region[1][1] - region[1][0]))
+        phi = n * np.pi * radius**2 / area
         raise ConfigError(key, round(phi, 4) if key.endswith("fraction") else n,
                           str(error)) from error
 
@@ -99,7 +126,15 @@ def _velocities(cfg, mass):
     return remove_drift(velocity, mass) if d.zero_momentum else velocity
 
 
-@scene("gas")
+def _gas_preparation(cfg):
+    d = cfg.disks
+    velocities = (f"Maxwellian at T = {d.temperature}" if d.temperature is not None
+                  else f"speed {d.speed} in random directions")
+    return (f"{PLACEMENTS[_placement(cfg, d.n, _gas_radius(cfg))]}; {velocities}"
+            + (", zero total momentum" if d.zero_momentum else ""))
+
+
+@scene("gas", _gas_preparation)
 def gas(cfg):
     n = cfg.disks.n
     radius = _gas_radius(cfg)
@@ -108,11 +143,11 @@ def gas(cfg):
                  np.zeros(n, np.int32), _boundary(cfg))
 
 
-scene("cooling")(gas)
-scene("driven")(gas)
+scene("cooling", _gas_preparation)(gas)
+scene("driven", _gas_preparation)(gas)
 
 
-@scene("mixture")
+@scene("mixture", _gas_preparation)
 def mixture(cfg):
     base = gas(cfg)
     n = cfg.disks.n
@@ -159,15 +194,25 @@ def scattering(cfg):
                  np.array([0, 1], np.int32), _boundary(cfg))
 
 
+def _bed_region(cfg):
+    return (0.0, float(cfg.box.size[0])), (0.0, float(cfg.bed.height))
+
+
 def _bed(cfg):
     """Positions float64[n, 2] of the bed disks, at rest in 0 ≤ y ≤ bed.height."""
     b = cfg.bed
-    lx = float(cfg.box.size[0])
-    return _place(cfg, float(b.radius), int(b.n), region=((0.0, lx), (0.0, float(b.height))),
-                  key="bed.n")
+    return _place(cfg, float(b.radius), int(b.n), region=_bed_region(cfg), key="bed.n")
 
 
-@scene("vibrated_bed")
+def _bed_preparation(cfg):
+    b = cfg.bed
+    placed = PLACEMENTS[_placement(cfg, int(b.n), float(b.radius), _bed_region(cfg))]
+    settled = (f", settled for t = {b.settle_time} under gravity"
+               if b.settle_time is not None else "")
+    return f"bed: {placed}{settled}, at rest"
+
+
+@scene("vibrated_bed", _bed_preparation)
 def vibrated_bed(cfg):
     b = cfg.bed
     n = int(b.n)
@@ -187,7 +232,7 @@ def _settled(cfg, position):
     return engine.positions(b.settle_time), engine.velocities(b.settle_time)
 
 
-@scene("crater")
+@scene("crater", _bed_preparation)
 def crater(cfg):
     p, b = cfg.projectile, cfg.bed
     bed = _bed(cfg)

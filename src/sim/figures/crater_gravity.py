@@ -79,6 +79,7 @@ def draw(runs, sweeps, out_dir):
     large = area > projectile_area
     large_fit = stats.linregress(np.log(energy[large]), np.log(area[large]))
     fig, (left, right) = figure(width=10)
+    fig.suptitle(ds.attrs.get("preparation", "preparation not recorded"), fontsize=9)
     curve = np.geomspace(energy.min(), energy.max(), 100)
     left.loglog(energy[opened], area[opened], "o", color="C0", label="largest cavity")
     left.loglog(curve, np.exp(fit.intercept) * curve**fit.slope, "-", color="C0", lw=1,
@@ -92,11 +93,14 @@ def draw(runs, sweeps, out_dir):
     left.set(xlabel="impact energy E (bed-disk mass × g × box length)",
              ylabel="crater area A (box units²)", title="transient crater under gravity")
     left.legend(fontsize=8)
+    ticks = [e for e in (20, 50, 100, 200, 500, 1000, 2000, 5000, 10000)
+             if energy[opened].min() / 1.5 <= e <= 1.5 * energy[opened].max()]
+    left.set_xticks(ticks, labels=[f"{e:g}" for e in ticks])
     left.xaxis.set_minor_formatter(NullFormatter())
     for k, (_, cavity, time, _) in enumerate(cavities):
         right.plot(time, cavity, color=f"C{k}", lw=1, label=f"v₀ = {speed[k]:g}")
     right.set(xlabel="time (√(L/g))", ylabel="empty area under the surface (box units²)",
-              title=f"the cavity opens and closes (Δx = {cavities[0][3]:.4g})")
+              title=f"the cavity opens and closes (Δx = {cavities[0][3]:.3g})")
     right.legend(fontsize=7)
     np.savetxt(out_dir / f"{NAME}.csv", np.column_stack([speed, energy, area, final]),
                delimiter=",", fmt="%.6g",

@@ -11,26 +11,17 @@ start (gaps between resting disks) and at the end.
 """
 
 import numpy as np
-from matplotlib.collections import EllipseCollection
 
 from sim.analysis import open_run
-from sim.crater import crater_area
-from sim.figures.crater_runs import CraterGeometry, crater_overrides
-from sim.figures.style import figure, save
+from sim.crater import CraterGeometry, crater_area
+from sim.figures.crater_runs import crater_overrides
+from sim.figures.style import draw_disks, figure, save
 
 NAME = "fig08_crater_grid"
 
 
 def runs(quick):
     return {"crater": crater_overrides(quick)}
-
-
-def draw_disks(ax, position, radius, colors):
-    """Disks at their true size (data units) on ``ax``."""
-    ax.add_collection(EllipseCollection(2 * radius, 2 * radius, np.zeros_like(radius),
-                                        units="xy", offsets=position,
-                                        offset_transform=ax.transData, facecolors=colors,
-                                        linewidths=0))
 
 
 def draw(runs, sweeps, out_dir):
@@ -41,23 +32,27 @@ def draw(runs, sweeps, out_dir):
         radius = ds["radius"].values
         t_end = float(ds["time"].values[-1])
         energy = ds["kinetic_energy"].values
+        box = ds.attrs["box"]
+        preparation = ds.attrs["preparation"]
     area, occupied = crater_area(end[geometry.bed], geometry.radius, geometry.dx,
                                  geometry.width, geometry.height)
     grid = occupied.T.astype(float)
     extent = (0, occupied.shape[0] * geometry.dx, 0, occupied.shape[1] * geometry.dx)
     fig, (left, right) = figure(width=11, height=4.4)
+    fig.suptitle(preparation, fontsize=9)
     left.imshow(grid, origin="lower", extent=extent, cmap="viridis", vmin=0, vmax=1,
                 interpolation="nearest")
     left.grid(False)
     right.grid(False)
     left.set(xlabel="x (box units)", ylabel="y (box units)", aspect="equal",
-             title=f"grid Δx = {geometry.dx:.4g}: occupied (yellow), empty (purple)")
+             xlim=(0, geometry.width), ylim=(0, float(box[1])),
+             title=f"grid Δx = {geometry.dx:.3g}: occupied (yellow), empty (purple)")
     colors = np.where(geometry.bed, "0.35", "tab:red")
     draw_disks(right, end, radius, colors)
     right.imshow(np.ma.masked_where(grid > 0, 1 - grid), origin="lower", extent=extent,
                  cmap="Purples", vmin=0, vmax=1.5, alpha=0.6, interpolation="nearest")
-    right.set(xlim=(0, geometry.width), ylim=(0, 1), aspect="equal", xlabel="x (box units)",
-              ylabel="y (box units)",
+    right.set(xlim=(0, geometry.width), ylim=(0, float(box[1])), aspect="equal",
+              xlabel="x (box units)", ylabel="y (box units)",
               title=f"t = {t_end:.3g}, E/E₀ = {energy[-1] / energy[0]:.2f}: "
                     f"crater area {area:.4f}")
     rows = []

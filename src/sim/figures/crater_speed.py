@@ -24,7 +24,8 @@ resting disks).
 import numpy as np
 
 from sim.analysis import open_sweep
-from sim.figures.crater_runs import CraterGeometry, crater_overrides
+from sim.crater import CraterGeometry
+from sim.figures.crater_runs import crater_overrides
 from sim.figures.style import figure, save
 
 NAME = "fig10_crater_speed"
@@ -54,6 +55,7 @@ def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["speed"])
     v0 = ds["projectile_speed"].values
     fig, (left, middle, right) = figure(ncols=3, width=14, height=4.4)
+    fig.suptitle(ds.attrs.get("preparation", "preparation not recorded"), fontsize=9)
     rows = []
     for k, speed in enumerate(v0):
         one = ds.isel(projectile_speed=k)
@@ -86,7 +88,7 @@ def draw(runs, sweeps, out_dir):
     middle.semilogx(v0, table[:, 2 + n], "s--", label="10 % energy left (study)")
     middle.set(xlabel="impact speed v₀ (box units / time)", ylabel="crater area (box units²)",
                ylim=(0, 1.2 * table[:, 2:2 + 2 * n].max()),
-               title=f"area against speed, Δx = {table[0, 1]:.4g}")
+               title=f"area against speed, Δx = {table[0, 1]:.3g}")
     middle.legend(fontsize=8)
     for j, factor in enumerate(SPACING_FACTORS):
         right.semilogx(v0, table[:, 2 + j], "o-", color=f"C{j}", label=f"Δx × {factor:g}")

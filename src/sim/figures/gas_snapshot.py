@@ -1,11 +1,12 @@
-"""Figure 4: a gas of 10 000 disks after 100 000 events (10 per disk) — velocity arrows
-coloured by speed — and its kinetic energy against events (elastic: constant to round-off)."""
+"""Figure 4: a gas of 10 000 disks after 100 000 events (10 per disk), the disks drawn to
+scale and coloured by speed, and its kinetic energy against events (elastic: constant to
+round-off)."""
 
 import numpy as np
 
 from sim.analysis import open_run
 from sim.figures.gas_runs import gas_overrides
-from sim.figures.style import figure, save
+from sim.figures.style import draw_disks, figure, save
 
 NAME = "fig04_gas_snapshot"
 
@@ -22,14 +23,16 @@ def draw(runs, sweeps, out_dir):
         k = min(k, events.size - 1)
         position = ds["position"].isel(time=k).values
         velocity = ds["velocity"].isel(time=k).values
+        radius = ds["radius"].values
+        box = ds.attrs["box"]
         energy = ds["kinetic_energy"].values
         n = ds.sizes["disk"]
     speed = np.hypot(velocity[:, 0], velocity[:, 1])
     fig, (left, right) = figure(width=10, height=4.6)
-    arrows = left.quiver(position[:, 0], position[:, 1], velocity[:, 0], velocity[:, 1], speed,
-                         cmap="viridis", scale=60 if n > 2000 else 25, width=0.002)
-    fig.colorbar(arrows, ax=left, label="speed (box units / time)")
-    left.set(xlim=(0, 1), ylim=(0, 1), aspect="equal", xlabel="x (box units)",
+    disks = draw_disks(left, position, radius, values=speed)
+    fig.colorbar(disks, ax=left, label="speed (box units / time)")
+    left.grid(False)
+    left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xlabel="x (box units)",
              ylabel="y (box units)", title=f"{n} disks after {events[k]} events")
     right.plot(events, energy / energy[0] - 1.0, color="C0")
     right.set(xlabel="events (disk and wall contacts)", ylabel="E / E₀ − 1",

@@ -1,6 +1,6 @@
 """Figure 2: two disks in a box.
 
-An animation of the first run (GIF), and the divergence of two runs whose starts differ by
+The divergence of two runs whose starts differ by
 1e-12 in one coordinate: the distance between the two copies against disk–disk collisions.
 Each disk–disk collision multiplies a small error by about 2ℓ/R (ℓ the distance flown since
 the previous disk–disk collision, R the radius: the defocusing of a convex scatterer), so
@@ -8,10 +8,7 @@ order is lost after about ln(R/1e-12) / ln(2ℓ/R) collisions; the figure fits t
 rate per collision and compares that estimate with the count it measures.
 """
 
-import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
-from matplotlib.patches import Circle
 
 from sim.analysis import open_run
 from sim.figures.style import figure, save
@@ -27,41 +24,12 @@ def runs(quick):
     return {"start": common, "perturbed": [*common, moved]}
 
 
-def _animate(ds, out_dir, frames=60):
-    position = ds["position"].values
-    radius = ds["radius"].values
-    box = ds.attrs["box"]
-    stride = max(1, len(position) // frames)
-    fig, ax = plt.subplots(figsize=(3.6, 3.6), constrained_layout=True)
-    ax.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[])
-    disks = [ax.add_patch(Circle(position[0, k], radius[k], color=f"C{k}")) for k in (0, 1)]
-    trails = [ax.plot([], [], "-", color=f"C{k}", lw=0.6, alpha=0.5)[0] for k in (0, 1)]
-    title = ax.set_title("")
-
-    def frame(f):
-        k = f * stride
-        for d in (0, 1):
-            disks[d].center = position[k, d]
-            trails[d].set_data(position[max(0, k - 60):k + 1, d, 0],
-                               position[max(0, k - 60):k + 1, d, 1])
-        title.set_text(f"t = {float(ds['time'][k]):.2f}, collisions "
-                       f"{int(ds['collisions'][k])}")
-        return [*disks, *trails, title]
-
-    animation = FuncAnimation(fig, frame, frames=len(position) // stride, blit=False)
-    path = out_dir / f"{NAME}.gif"
-    animation.save(path, writer=PillowWriter(fps=20))
-    plt.close(fig)
-    return path
-
-
 def draw(runs, sweeps, out_dir):
     with open_run(runs["start"]) as a, open_run(runs["perturbed"]) as b:
         k = min(a.sizes["time"], b.sizes["time"])
         distance = np.abs(a["position"].values[:k] - b["position"].values[:k]).max(axis=(1, 2))
         collisions = a["collisions"].values[:k]
         radius = float(a["radius"][0])
-        _animate(a, out_dir)
     lost = np.flatnonzero(distance > radius)
     k_lost = int(lost[0]) if lost.size else k - 1
     c_lost = int(collisions[k_lost])

@@ -1,0 +1,195 @@
+"""Movies of runs (sim.movie): frames evenly spaced in time, disks in free flight from the latest
+snapshot, drawn where the positions say; MP4 or GIF written whole; bad input is one line and
+exit status 2."""
+
+import warnings
+
+import imageio_ffmpeg
+import numpy as np
+import pytest
+from PIL import Image
+from scipy import ndimage
+
+from sim import movie
+from sim.analysis import open_run
+from sim.figures.runs import compose_config
+from sim.runner import run
+
+#: the two disks of the two_disks scene, their snapshots 0.01 apart
+TWO_DISKS = ["scenario=two_disks", "stop.time=2", "output.every_time=0.01",
+             "output.progress=false"]
+SCENES = {"walls_and_gravity": [*TWO_DISKS, "gravity=[0,-1]"],
+          "periodic": [*TWO_DISKS, "box.boundary=periodic", "observe.clusters.gap=3"]}
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Run files by scene name, made once for the module."""
+    made = {}
+    for name, overrides in SCENES.items():
+        folder = tmp_path_factory.mktemp(name)
+        made[name] = run(compose_config(overrides), folder)
+    return made
+
+
+def read_mp4(path):
+    """(width, height) and the frames uint8[h, w, 3] of an MP4."""
+    with warnings.catch_warnings():
+        # read_frames leaves ffmpeg's pipes to the garbage collector when ffmpeg ends first
+        warnings.simplefilter("ignore", ResourceWarning)
+        reader = imageio_ffmpeg.read_frames(str(path))
+        width, height = next(reader)["size"]
+        frames = [np.frombuffer(f, np.uint8).reshape(height, width, 3) for f in reader]
+    return (width, height), frames
+
+
+@pytest.mark.parametrize("scene", sorted(SCENES))
+def test_free_flight_from_sparse_snapshots_gives_the_dense_ones_between_contacts(runs, scene):
+    with open_run(runs[scene]) as ds:
+        time = ds["time"].values
+        position, velocity = ds["position"].values, ds["velocity"].values
+        contacts = ds["collisions"].values + ds["wall_collisions"].values
+        snapshots = movie.Snapshots(ds)
+        gravity, box, periodic = snapshots.gravity, snapshots.box, snapshots.periodic
+    assert (gravity is not None) == (scene == "walls_and_gravity")
+    sparse = np.arange(0, time.size, 10)
+    latest, elapsed = movie.latest_snapshots(time[sparse], time)
+    k = sparse[latest]
+    assert np.all(time[k] <= time) and np.all(elapsed >= 0.0)  # never predicted backwards
+    free = contacts[k] == contacts  # no contact between the sparse snapshot and this one
+    assert free.sum() > 0.8 * time.size and np.sum(elapsed[free] > 0.0) > 100
+    for j in np.flatnonzero(free):
+        r, v = movie.free_flight(position[k[j]], velocity[k[j]], elapsed[j], gravity, box,
+                                 periodic)
+        np.testing.assert_allclose(v, velocity[j], rtol=0.0, atol=1e-12)
+        apart = r - position[j]
+        apart -= np.where(periodic, box * np.round(apart / box), 0.0)  # x = 0 is x = L
+        np.testing.assert_allclose(apart, 0.0, rtol=0.0, atol=1e-12)
+        if any(periodic):
+            assert np.all((r >= 0.0) & (r <= box))
+    wrapped = np.flatnonzero(np.any(np.abs(np.diff(position, axis=0)) > 0.5, axis=(1, 2)))
+    assert (wrapped.size > 0) == (scene == "periodic")  # the periodic disks crossed a side
+
+
+def test_frames_show_the_disks_where_free_flight_puts_them(runs, tmp_path):
+    out = tmp_path / "two.mp4"
+    times = np.linspace(0.105, 1.9, 12)  # between snapshots, from the latest before each
+    movie.make_movie(runs["walls_and_gravity"], out, fps=10, frames=times.size,
+                     start=times[0], stop=times[-1], color="species")
+    layout = movie.Layout.of_view((0.0, 1.0, 0.0, 1.0))
+    size, frames = read_mp4(out)
+    assert size == (layout.width, layout.height) and len(frames) == times.size
+    assert layout.width % 16 == 0 and layout.height % 16 == 0
+    with open_run(runs["walls_and_gravity"]) as ds:
+        expected = [f.position for f in movie.Snapshots(ds).frames(times)]
+        radius = float(ds["radius"][0])
+    radius_pixels = radius * layout.box_width
+    checked = 0
+    for picture, position in zip(frames, expected, strict=True):
+        by_a_wall = np.any((position < 2 * radius) | (position > 1 - 2 * radius))
+        if by_a_wall or np.hypot(*(position[0] - position[1])) < 3 * radius:
+            continue  # blobs would be clipped by a wall's line or merge
+        rgb = picture.astype(np.int64)
+        colored = rgb.max(axis=2) - rgb.min(axis=2) > 60  # the species colour: not grey
+        inside = np.zeros_like(colored)  # the box, not the colour key beside it
+        inside[layout.top:layout.top + layout.box_height,
+               layout.left:layout.left + layout.box_width] = True
+        blobs, _ = ndimage.label(colored & inside)
+        areas = np.bincount(blobs.ravel())[1:]
+        disks = 1 + np.flatnonzero(areas > 0.5 * np.pi * radius_pixels**2)  # not codec specks
+        assert disks.size == 2
+        centres = np.array(ndimage.center_of_mass(colored, blobs, disks))[:, ::-1] + 0.5
+        np.testing.assert_allclose(areas[disks - 1], np.pi * radius_pixels**2, rtol=0.03)
+        pixels = layout.pixel(position)
+        distance = np.hypot(*(centres[:, None, :] - pixels[None, :, :]).transpose(2, 0, 1))
+        assert distance.min(axis=1).max() < 1.0, distance
+        checked += 1
+    assert checked >= 4
+
+
+def test_gif_by_name_and_when_ffmpeg_is_unavailable(runs, tmp_path, monkeypatch, capsys):
+    gif = tmp_path / "clusters.gif"  # the run has no clusters observable: labels computed
+    assert movie.main([str(runs["walls_and_gravity"]), "--out", str(gif), "--frames", "4",
+                       "--color", "cluster"]) == 0
+    with Image.open(gif) as image:
+        assert image.n_frames == 4
+        width, height = image.size
+    layout = movie.Layout.of_view((0.0, 1.0, 0.0, 1.0))
+    assert (width, height) == (layout.width, layout.height)
+
+    def unavailable():
+        raise RuntimeError("No ffmpeg exe could be found.")
+
+    monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", unavailable)
+    capsys.readouterr()
+    assert movie.main([str(runs["periodic"]), "--out", str(tmp_path / "asked.mp4"),
+                       "--duration", "0.5", "--fps", "6"]) == 0
+    notes = capsys.readouterr().err.splitlines()
+    assert len(notes) == 1 and "through Pillow" in notes[0]
+    assert not (tmp_path / "asked.mp4").exists()
+    with Image.open(tmp_path / "asked.gif") as image:
+        assert image.n_frames == 3
+
+
+def test_a_movie_that_fails_leaves_no_file(runs, tmp_path, monkeypatch):
+    render = movie.Picture.render
+    drawn = []
+
+    def failing(picture, frame):
+        drawn.append(frame.time)
+        if len(drawn) == 3:
+            raise OSError("disk full")
+        return render(picture, frame)
+
+    monkeypatch.setattr(movie.Picture, "render", failing)
+    assert movie.main([str(runs["periodic"]), "--out", str(tmp_path / "m.mp4"),
+                       "--frames", "5"]) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_frames_across_contacts_are_noted_in_one_line(runs, tmp_path, capsys):
+    with open_run(runs["walls_and_gravity"]) as ds:
+        time = ds["time"].values
+        gained = np.diff(2 * ds["collisions"].values + ds["wall_collisions"].values)
+    # two frames inside one snapshot interval: one without contacts, then one with a contact
+    # (0.5 or more contacts per disk, above the 0.1 that makes the note)
+    for k, noted in ((np.flatnonzero(gained == 0)[0], False), (np.flatnonzero(gained)[0], True)):
+        assert movie.main([str(runs["walls_and_gravity"]), "--out", str(tmp_path / f"{k}.gif"),
+                           "--frames", "2", "--start", str(time[k] + 0.002),
+                           "--stop", str(time[k] + 0.008)]) == 0
+        notes = capsys.readouterr().err.splitlines()
+        assert len(notes) == noted
+    assert "note: 2 of 2 frames lie between snapshots" in notes[0]
+
+
+def test_cluster_labels_follow_the_rule_of_the_observer(runs):
+    with open_run(runs["periodic"]) as ds:
+        labels = movie.cluster_rule(movie.Snapshots(ds), ds["radius"].values)
+        observed = ds["clusters"].values
+        position = ds["position"].values
+    assert all(np.array_equal(labels(p), o) for p, o in zip(position, observed, strict=True))
+    assert {tuple(o) for o in observed} >= {(0, 0), (0, 1)}  # together and apart
+
+
+@pytest.mark.parametrize("args, says", [
+    (["missing.h5"], "no such file"),
+    (["not_a_run.h5"], "not a readable HDF5 file"),
+    (["RUN", "--fps", "0"], "--fps"),
+    (["RUN", "--fps", "fast"], "--fps"),
+    (["RUN", "--frames", "0"], "--frames"),
+    (["RUN", "--frames", "3", "--duration", "2"], "not allowed with"),
+    (["RUN", "--start", "-1"], "--start"),
+    (["RUN", "--stop", "99"], "--stop"),
+    (["RUN", "--color", "mood"], "--color"),
+    (["RUN", "--out", "movie.avi"], ".mp4 or .gif"),
+    (["RUN", "--out", "nowhere/movie.mp4"], "no folder"),
+])
+def test_bad_input_is_one_line_and_status_2(runs, tmp_path, monkeypatch, capsys, args, says):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "not_a_run.h5").write_text("hello")
+    argv = [str(runs["periodic"]) if a == "RUN" else a for a in args]
+    assert movie.main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and says in err and err.startswith("sim-movie: ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_run.h5"]
+    assert not any(p.suffix in (".mp4", ".gif") for p in runs["periodic"].parent.iterdir())
