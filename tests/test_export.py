@@ -10,6 +10,7 @@ a float32 ulp of L/2. XYZ holds float64 and is compared bit for bit.
 
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 
@@ -20,6 +21,7 @@ import numpy as np
 import pytest
 import yaml
 
+import sim.export
 from sim.analysis import open_run
 from sim.export import ExportError, export, frame_indices, hoomd_positions, main
 from sim.figures.runs import compose_config
@@ -179,8 +181,6 @@ BAD_INPUT = {
     "zero step": lambda run, folder: ([run, "--format", "xyz", "--frames", "::0"], "::0"),
     "out of range": lambda run, folder: ([run, "--format", "gsd", "--frames", "0,6"], "6"),
     "no frame": lambda run, folder: ([run, "--format", "gsd", "--frames", "6:"], "6:"),
-    "no folder": lambda run, folder: ([run, "--format", "gsd", "--out", folder / "no" / "x"],
-                                      "cannot write"),
     "the run file": lambda run, folder: ([run, "--format", "xyz", "--out", run], "itself"),
 }
 
@@ -197,6 +197,31 @@ def test_bad_input_is_one_line_exit_2_and_leaves_nothing(case, mixture, tmp_path
     assert out == "" and err.startswith("sim-export: ") and err.count("\n") == 1
     assert named in err and "Traceback" not in err
     assert sorted(tmp_path.rglob("*")) == before
+
+
+def test_an_output_that_cannot_be_written_is_one_line_exit_1(mixture, tmp_path, capsys):
+    capsys.readouterr()
+    assert sim_export(mixture, "--format", "gsd", "--out", tmp_path / "no" / "x.gsd") == 1
+    _, err = capsys.readouterr()
+    assert err.startswith("sim-export: cannot write ") and err.count("\n") == 1
+    assert not (tmp_path / "no").exists()
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_during_the_export_leaves_nothing(signum, mixture, tmp_path, monkeypatch,
+                                                   capsys):
+    """A signal half-way through the writing (as the handler raises it): one line, 128 +
+    the signal's number, and neither the output nor its hidden part."""
+    def interrupted(path, run, frames):
+        path.write_bytes(b"half a file")
+        raise KeyboardInterrupt(signum)
+
+    monkeypatch.setitem(sim.export.WRITERS, "gsd", interrupted)
+    capsys.readouterr()
+    assert sim_export(mixture, "--format", "gsd", "--out", tmp_path / "x.gsd") == 128 + signum
+    _, err = capsys.readouterr()
+    assert err.startswith("sim-export: ") and "nothing written" in err and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_the_command_refuses_in_one_line(tmp_path):

@@ -166,6 +166,26 @@ def test_a_write_the_system_refuses_unforeseen_ends_with_one_line(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("sim: writing the run file"), lines
 
 
+#: a failed HDF5 write that escapes every report of the run: h5py's own traceback of it is
+#: passed over, so the command must still say it, in one line, at exit
+UNREPORTED_FAILURE = """
+import atexit, sys
+from sim import cli
+sys.excepthook = cli._quiet_hdf5_traceback
+atexit.register(cli._report_passed_over)
+raise OSError("Driver write request failed (file write failed: errno = 27, "
+              "error message = 'File too large')")
+"""
+
+
+def test_a_failed_write_that_nothing_reported_is_said_at_exit(tmp_path):
+    process = subprocess.run([sys.executable, "-c", UNREPORTED_FAILURE], cwd=tmp_path,
+                             capture_output=True, text=True, timeout=300)
+    lines = [line for line in process.stderr.splitlines() if line.strip()]
+    assert process.returncode == 1
+    assert len(lines) == 1 and lines[0].startswith("sim: writing the run file failed:"), lines
+
+
 def test_a_folder_that_cannot_be_written_is_a_clear_error(tmp_path):
     cfg = compose_config(["disks.n=100", "output.progress=false"])
     with pytest.raises(runner.RunFileError, match="cannot write the run file /proc/x/run.h5"):

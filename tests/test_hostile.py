@@ -773,38 +773,52 @@ def test_sigterm_ends_a_run_resumably_and_resume_finishes_it(tmp_path):
     assert not hidden_leftovers(tmp_path)
 
 
-def _catches_sigint(pid):
-    try:
-        status = Path(f"/proc/{pid}/status").read_text()
-    except OSError:
-        return True  # gone: the caller sees it end
-    mask = int(re.search(r"SigCgt:\s*([0-9a-f]+)", status).group(1), 16)
-    return bool(mask & (1 << (signal.SIGINT - 1)))
+#: ``python -m sim`` that sends itself SIGINT at a moment of its start-up, the first argument:
+#: as the import of that module begins (a finder put first on sys.meta_path), or, for
+#: "locked", once the run folder is made and its lock taken, before the run file. The moment
+#: is set by the program, not by a clock, so that a loaded machine cannot move it.
+SELF_INTERRUPTED = """
+import importlib.abc, os, runpy, signal, sys
+moment = sys.argv.pop(1)
 
 
-#: after CPython handles SIGINT at all (its own start-up before that is not sim's to handle):
-#: while the modules are imported; and once the run folder is made, before the run file
-STARTUP_MOMENTS = ["imports+0.1s", "imports+0.3s", "imports+0.6s", "folder-appears"]
+def interrupt():
+    os.kill(os.getpid(), signal.SIGINT)
+
+
+class AtImport(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name == moment:
+            sys.meta_path.remove(self)
+            interrupt()
+        return None
+
+
+if moment == "locked":
+    import sim.run_folder
+    take = sim.run_folder.RunLock.__enter__
+
+    def taken(lock):
+        take(lock)
+        interrupt()
+        return lock
+
+    sim.run_folder.RunLock.__enter__ = taken
+else:
+    sys.meta_path.insert(0, AtImport())
+sys.argv = ["sim", *sys.argv[1:]]
+runpy.run_module("sim", run_name="__main__")
+"""
+
+#: while the modules the command line needs are imported, and once its run folder is locked
+STARTUP_MOMENTS = ["hydra", "numba", "h5py", "sim.engine", "locked"]
 
 
 @pytest.mark.parametrize("moment", STARTUP_MOMENTS)
 def test_sigint_during_start_up_is_one_line_exit_130_and_leaves_nothing(moment, tmp_path):
-    process = start(*SMALL, "hydra.run.dir=X", cwd=tmp_path)
-    try:
-        deadline = time.monotonic() + HANG_GUARD
-        if moment == "folder-appears":
-            wait_for(tmp_path / "X", process, poll=0.001)
-        else:
-            while not _catches_sigint(process.pid) and time.monotonic() < deadline:
-                time.sleep(0.001)
-            time.sleep(float(moment.split("+")[1][:-1]))
-        published = (tmp_path / "X" / "run.h5").exists()
-    finally:
-        process.send_signal(signal.SIGINT)
-        result = finish(process)
-    if "Fatal Python error: init" in result.err:
-        pytest.skip("SIGINT landed in CPython's own initialisation, before any code of sim")
-    assert not published, "the run file appeared before SIGINT was sent: not start-up"
+    done = subprocess.run([PY, "-c", SELF_INTERRUPTED, moment, QUIET, *SMALL, "hydra.run.dir=X"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=HANG_GUARD)
+    result = Result(done.returncode, done.stdout, done.stderr)
     check(result, 130, [])
     files = [p for p in tmp_path.rglob("*") if not p.is_dir()]
     assert not files, files

@@ -208,7 +208,8 @@ def test_inspect_names_the_boundary_and_the_observables(tmp_path):
     path = runner.run(compose_scene("gas", "stop.collisions=500", "walls.bottom.temperature=2",
                                     "observe.clusters.gap=0.1"), tmp_path)
     info = summary(path)
-    assert info["boundary"] == "x: walls, y: walls (bottom thermal at T = 2)"
+    assert info["boundary"] == ["walls", "walls"]
+    assert info["walls"] == "bottom thermal at T = 2"
     assert {"clusters", "kinetic_energy", "collisions"} <= set(info["observables"])
 
 

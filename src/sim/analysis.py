@@ -16,8 +16,9 @@ the initial state was made (``preparation``), stop reason, box edges and boundar
 parameter as a dimension (``projectile.radius`` → ``projectile_radius``); runs are aligned by
 snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate; a run with
 fewer snapshots than another is padded with NaN, and its integer counters (``collisions``,
-``wall_collisions``) with −1, so that they stay integers; each run's resolved config (YAML)
-and stop reason are the variables ``config`` and ``stop_reason``.
+``wall_collisions``) with −1, so that they stay integers; each run's resolved config (YAML),
+stop reason and preparation are the variables ``config``, ``stop_reason`` and
+``preparation``.
 """
 
 import warnings
@@ -212,7 +213,7 @@ def open_sweep(multirun_dir):
     overrides = [_labels(run) for run in runs]
     keys = sorted({k for o in overrides for k in o})
     swept = [k for k in keys if len({repr(o.get(k)) for o in overrides}) > 1]
-    datasets, configs, reasons = [], [], []
+    datasets, configs, reasons, preparations = [], [], [], []
     for run, override in zip(runs, overrides, strict=True):
         ds = open_run(run).load()
         ds.close()
@@ -220,21 +221,24 @@ def open_sweep(multirun_dir):
             snapshot=np.arange(ds.sizes["time"]), time=("snapshot", ds["time"].values))
         configs.append(ds.attrs.pop("config"))
         reasons.append(ds.attrs.pop("stop_reason"))
+        preparations.append(ds.attrs.pop("preparation"))
         datasets.append(ds.expand_dims({k.replace(".", "_"): [override[k]]
                                         for k in swept}))
-    fill = {name: NOT_REACHED for name, variable in datasets[0].data_vars.items()
+    fill = {name: NOT_REACHED for ds in datasets for name, variable in ds.data_vars.items()
             if variable.dtype.kind in "iu"}
     if not swept:
         combined = xr.concat(datasets, dim="run", join="outer", data_vars="all",
                              coords="different", compat="equals", fill_value=fill)
-        combined["config"] = ("run", np.array(configs, dtype=object))
-        combined["stop_reason"] = ("run", np.array(reasons, dtype=object))
+        for name, texts in (("config", configs), ("stop_reason", reasons),
+                            ("preparation", preparations)):
+            combined[name] = ("run", np.array(texts, dtype=object))
         return combined
     combined = xr.combine_by_coords(datasets, join="outer", combine_attrs="drop_conflicts",
                                     data_vars="all", coords="different", compat="no_conflicts",
                                     fill_value=fill)
     dims = [k.replace(".", "_") for k in swept]
-    for name, texts in (("config", configs), ("stop_reason", reasons)):
+    for name, texts in (("config", configs), ("stop_reason", reasons),
+                        ("preparation", preparations)):
         per_run = xr.DataArray(np.empty([combined.sizes[d] for d in dims], dtype=object),
                                dims=dims, coords={d: combined[d] for d in dims})
         for override, text in zip(overrides, texts, strict=True):

@@ -18,6 +18,7 @@ status 2, and nothing is written. The exit statuses:
        ``resume=`` continues the run (a sweep: the same command with its hydra.sweep.dir)
 """
 
+import atexit
 import itertools
 import logging
 import math
@@ -41,6 +42,7 @@ from sim import callbacks, resources
 from sim.__main__ import caused_by_a_signal, leave
 from sim.config import ConfigError, integer_keys, register, validate
 from sim.engine import PhysicsBreakdown
+from sim.h5md import hdf5_reason
 from sim.inspect import summary
 from sim.run_folder import FolderBusyError, RunLock, new_folder
 from sim.runner import (
@@ -432,19 +434,36 @@ def _failed_hdf5_write(error):
     return isinstance(error, (OSError, RuntimeError)) and "write failed" in str(error)
 
 
+#: HDF5 write failures that h5py reported on its own (see :func:`_quiet_hdf5_teardown`)
+PASSED_OVER = []
+
+
 def _quiet_hdf5_teardown(unraisable):
     """HDF5 tries a failed write again as it releases the objects of that file (a dataset
     closed after a write it could not finish, wherever the writer's wall-clock flush left
     it), and h5py reports each failure: its traceback through ``sys.excepthook``, then
-    "Exception ignored" through ``sys.unraisablehook``. The run reports the failure in one
-    line; both hooks pass these over."""
-    if not _failed_hdf5_write(unraisable.exc_value):
+    "Exception ignored" through ``sys.unraisablehook``. Both hooks keep these in
+    :data:`PASSED_OVER` instead: the run's one-line report of the failure, which ends the
+    process, covers them; a process that ends without that report says the first of them
+    in one line and ends with status 1 (:func:`_report_passed_over`)."""
+    if _failed_hdf5_write(unraisable.exc_value):
+        PASSED_OVER.append(unraisable.exc_value)
+    else:
         sys.__unraisablehook__(unraisable)
 
 
 def _quiet_hdf5_traceback(kind, error, traceback):
-    if not _failed_hdf5_write(error):
+    if _failed_hdf5_write(error):
+        PASSED_OVER.append(error)
+    else:
         sys.__excepthook__(kind, error, traceback)
+
+
+def _report_passed_over():
+    """At exit (after any uncaught exception): a failed write that nothing reported."""
+    if PASSED_OVER:
+        leave(f"sim: writing the run file failed: {hdf5_reason(PASSED_OVER[0])}",
+              EXIT_RUN_FILE)
 
 
 def main():
@@ -452,6 +471,7 @@ def main():
     signal.signal(signal.SIGTERM, _terminate)  # before the run: SIGTERM as Ctrl-C
     sys.unraisablehook = _quiet_hdf5_teardown
     sys.excepthook = _quiet_hdf5_traceback
+    atexit.register(_report_passed_over)
     warnings.showwarning = _warn_in_one_line
     Interruption.at_second_signal = _stop_at_once
     args = whole_numbers(sys.argv[1:])

@@ -427,6 +427,11 @@ def validate(cfg: Any) -> None:
         raise ConfigError("output.every_collisions", o.every_collisions,
                           f"at most 2^62 = {MAX_COUNT}")
     _positive(c, "output.every_time", o.every_time)
+    if o.every_time is not None and c.stop.time is not None \
+            and math.ulp(float(c.stop.time)) > 1e-6 * o.every_time:
+        raise ConfigError("output.every_time", o.every_time,
+                          f"a cadence that float64 resolves up to stop.time = {c.stop.time}: "
+                          f"above {1e6 * math.ulp(float(c.stop.time)):.3g}")
     rdf = c.observe.radial_distribution
     if rdf.bins is not None:
         if rdf.bins < 1:
@@ -440,6 +445,10 @@ def validate(cfg: Any) -> None:
         raise ConfigError("observe.local_fields.cells", cells, "at least 1 cell along x")
     if c.scene in ("crater", "vibrated_bed"):
         _validate_bed(c)
+    if c.scene == "vibrated_bed" and c.bed.settle_time is not None:
+        raise ConfigError("bed.settle_time", c.bed.settle_time,
+                          "null: the vibrated bed starts at rest where it is placed (only the "
+                          "crater scene settles its bed first)")
     if c.scene == "crater":
         p, b = c.projectile, c.bed
         _positive(c, "bed.settle_time", b.settle_time)

@@ -101,12 +101,14 @@ class CraterGeometry:
 
 def area(run, snapshot=-1, dx=None):
     """Crater area (box units²) of a crater run at ``snapshot`` (default the last): ``run`` a
-    run-file path or an :func:`sim.analysis.open_run` Dataset; Δx calibrated on the run's
-    untouched bed unless given."""
+    run-file path, an :func:`sim.analysis.open_run` Dataset or one run selected from
+    :func:`sim.analysis.open_sweep`'s (whose shorter runs end in NaN: give their last
+    snapshot); Δx calibrated on the run's untouched bed unless given."""
     from sim.analysis import open_run  # the measure itself needs no run file
 
     if not hasattr(run, "attrs"):
         with open_run(run) as ds:
             return area(ds, snapshot, dx)
     geometry = CraterGeometry.of_run(run)
-    return geometry.area(np.asarray(run["position"].isel(time=snapshot).values), dx)
+    snapshot_dim = "snapshot" if "snapshot" in run.dims else "time"
+    return geometry.area(np.asarray(run["position"].isel({snapshot_dim: snapshot}).values), dx)

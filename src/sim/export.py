@@ -28,12 +28,14 @@ number (the GSD ``typeid``): ASE reads a ``species`` column as chemical elements
 list of snapshot indices, negative ones counted from the end; every snapshot by default.
 ``--out``: by default the run file's name with ``.gsd`` or ``.xyz``, beside it; the file is
 written under a hidden name beside it and renamed when whole. Units are the run's. Exit
-status 0, or 2 with one line on stderr: not a run file, a bad ``--frames``, a damaged
-snapshot among those asked, an output that cannot be written; nothing is left behind then.
+status 0; 2 with one line on stderr for bad input (not a run file, a bad ``--frames``, a
+damaged snapshot among those asked); 1 when the output cannot be written; 130 after Ctrl-C,
+143 after SIGTERM. Nothing is left behind but a whole file.
 """
 
 import argparse
 import os
+import signal
 import string
 import sys
 import warnings
@@ -42,6 +44,7 @@ from pathlib import Path
 import gsd.hoomd
 import numpy as np
 
+from sim.__main__ import interrupt
 from sim.analysis import open_run
 from sim.inspect import RunFileError
 
@@ -51,6 +54,10 @@ XYZ_PROPERTIES = "type:I:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1"
 
 class ExportError(ValueError):
     """A request that cannot be exported, said in one line."""
+
+
+class CannotWrite(OSError):
+    """The export file could not be written; nothing of it is left."""
 
 
 def frame_indices(spec, count):
@@ -190,7 +197,7 @@ def export(run_path, fmt, out=None, frames=None):
             os.replace(partial, target)
         except OSError as error:
             partial.unlink(missing_ok=True)
-            raise ExportError(f"cannot write {target} ({error.strerror or error})") from error
+            raise CannotWrite(f"cannot write {target} ({error.strerror or error})") from error
         except BaseException:
             partial.unlink(missing_ok=True)
             raise
@@ -211,13 +218,24 @@ def main(argv=None):
     parser.add_argument("--format", required=True, choices=sorted(WRITERS), dest="fmt")
     parser.add_argument("--out", help="output file (default: beside the run file)")
     parser.add_argument("--frames", help="start:stop:step or a comma list of snapshot indices "
-                                         "(default: all); --frames=-5: for the last five")
+                                         "(default: all), e.g. -5: (the last five) or 0,-1")
     args = parser.parse_args(argv)
+    previous = signal.signal(signal.SIGTERM, interrupt)  # SIGTERM cleans up as Ctrl-C does
     try:
         export(args.path, args.fmt, args.out, args.frames)
     except (RunFileError, ExportError) as error:
         print(f"sim-export: {' '.join(str(error).split())}", file=sys.stderr)
         return 2
+    except CannotWrite as error:
+        print(f"sim-export: {' '.join(str(error).split())}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt as error:
+        signum = error.args[0] if error.args else signal.SIGINT
+        how = "terminated" if signum == signal.SIGTERM else "interrupted"
+        print(f"sim-export: {how}; nothing written", file=sys.stderr)
+        return 128 + signum
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     return 0
 
 

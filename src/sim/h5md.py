@@ -14,7 +14,8 @@ Layout written by :class:`RunWriter`:
   /events/contacts            when the scene logs events (``observe.event_log``): one row per
                               contact, columns time, disk, partner, impulse, dissipated,
                               contact (:mod:`sim.recorders`), written at every flush
-  /parameters                 config (resolved YAML), overrides (YAML list), seed, versions,
+  /parameters                 config (resolved YAML), overrides (YAML list), seed, preparation
+                              (how the initial state was made, in words), versions,
                               git commit, stop reason; stop_message (a breakdown's), resumes
                               (YAML: each resume that changed something, from which snapshot)
   /checkpoint/{a,b}           the engine's full state at the last two snapshots, ``latest``

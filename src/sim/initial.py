@@ -195,10 +195,13 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
     return np.where(wraps, position % np.asarray(box, float), clipped)
 
 
-#: Collisions per disk of the elastic run that melts a lattice (:func:`melted_lattice`): at
-#: φ = 0.51 the global bond-orientational order |ψ₆| falls from 0.9 to the noise of a fluid
-#: (≲ 3/√n) within about 5, and tests/test_initial.py checks it at this count.
+#: Collisions per disk of the elastic run that melts a lattice (:func:`melted_lattice`):
+#: tests/test_initial.py checks that the crater bed's global bond-orientational order |ψ₆|
+#: (0.9 on the lattice) is then a fluid's, below 3/√n.
 MELT_COLLISIONS_PER_DISK = 20
+
+#: the stream of random numbers of a melt's velocities, apart from the scene's own
+MELT_STREAM = 7
 
 
 def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, False), seed=0,
@@ -214,11 +217,20 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
     wraps = tuple(bool(periodic[a]) and lo[a] == 0.0 and hi[a] == box[a] for a in range(2))
     position = hexagonal_lattice(n, radius, box=box, region=region, periodic=periodic, seed=seed)
     mass = np.ones(n)
-    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
-    engine = Engine(position - lo, velocity, radius, mass,
-                    boundary=Boundary(size=tuple(float(x) for x in hi - lo), periodic=wraps),
-                    seed=seed)
-    engine.run(collisions=round(0.5 * collisions_per_disk * n))
+    streams = np.random.SeedSequence((seed, MELT_STREAM))
+    velocity = remove_drift(maxwellian(mass, 1.0, seed=streams), mass)
+    collisions = round(0.5 * collisions_per_disk * n)
+    try:
+        engine = Engine(position - lo, velocity, radius, mass,
+                        boundary=Boundary(size=tuple(float(x) for x in hi - lo),
+                                          periodic=wraps), seed=seed)
+        reason = engine.run(collisions=collisions)
+    except ValueError as error:
+        raise PlacementError(f"the lattice could not be melted: {error}") from error
+    if reason != "collisions":
+        raise PlacementError(f"the lattice could not be melted: its elastic run stopped after "
+                             f"{engine.collisions} of {collisions} collisions ({reason}); "
+                             f"use disks.placement=lattice")
     return engine.positions() + lo
 
 

@@ -256,7 +256,7 @@ def summary(path, verify=True):
                 "scene": config.get("scene"),
                 "n": int(f["particles/disks/radius"].shape[0]),
                 "species": None if np.isnan(species).any() else int(np.max(species) + 1),
-                "boundary": _boundary(f["particles/disks/box"].attrs["boundary"], config),
+                "boundary": _boundary(f["particles/disks/box"].attrs["boundary"]),
                 "observables": sorted(f["observables"]),
                 "snapshots": int(time.size),
                 "time_span": [_at(time, 0), _at(time, -1)] if time.size else None,
@@ -268,6 +268,7 @@ def summary(path, verify=True):
                 "seed": int(parameters["seed"]),
                 "creator": f"{creator['name']} {creator['version']}",
             }
+            result["walls"] = _walls(result["boundary"], config)
             checksums = _checksums(f)
         except (*DAMAGE, yaml.YAMLError) as error:
             raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
@@ -286,22 +287,25 @@ def summary(path, verify=True):
     return result
 
 
-def _boundary(kinds, config):
-    """The box's edges in words: ``periodic`` or ``walls`` along x and y (H5MD writes a walled
-    axis as ``none``), then every wall that is not a plain hard wall."""
-    axes = [f"{axis}: {'periodic' if kind.decode() == 'periodic' else 'walls'}"
-            for axis, kind in zip("xy", kinds, strict=True)]
+def _boundary(kinds):
+    """``periodic`` or ``walls`` along x and y (H5MD writes a walled axis as ``none``)."""
+    return ["periodic" if kind.decode() == "periodic" else "walls" for kind in kinds]
+
+
+def _walls(boundary, config):
+    """The walls that are not plain hard walls, in words, or ``hard`` (None without walls)."""
+    if "walls" not in boundary:
+        return None
     special = []
-    walled = any(kind.decode() != "periodic" for kind in kinds)
-    for name, wall in (config.get("walls") or {}).items() if walled else ():
+    for name, wall in (config.get("walls") or {}).items():
         if wall.get("temperature") is not None:
             special.append(f"{name} thermal at T = {wall['temperature']:g}")
         if wall.get("speed"):
             special.append(f"{name} moving at {wall['speed']:g}")
-        if wall.get("amplitude"):
+        if wall.get("amplitude") and wall.get("frequency"):
             special.append(f"{name} oscillating, amplitude {wall['amplitude']:g}, "
                            f"ω = {wall['frequency']:g}")
-    return ", ".join(axes) + (f" ({'; '.join(special)})" if special else "")
+    return "; ".join(special) or "hard"
 
 
 CHECKSUMS = {"all": "on every dataset (fletcher32)",

@@ -51,6 +51,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from PIL import Image
 
+from sim.__main__ import interrupt
 from sim.analysis import open_run
 from sim.gravity import gravity_vector
 from sim.inspect import RunFileError
@@ -92,9 +93,10 @@ def free_flight(position, velocity, elapsed, gravity=None, box=None, periodic=(F
 
 
 def round_off(snapshot_times):
-    """The time within which two instants of a run are the same (snapshot times add up their
-    cadence, so a grid time and a snapshot's differ by round-off)."""
-    return 1e-9 * max(1.0, float(np.max(np.abs(snapshot_times))))
+    """The time within which two instants of a run are the same: a few ulps of the largest
+    snapshot time (snapshot times are multiples k Δt and frame times come from linspace, so
+    the same instant differs between them by round-off only)."""
+    return 8.0 * float(np.spacing(np.max(np.abs(snapshot_times))))
 
 
 def latest_snapshots(snapshot_times, times):
@@ -581,9 +583,6 @@ class _Parser(argparse.ArgumentParser):
         raise InputError(message)
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt(signum)
-
 
 def main(argv=None):
     parser = _Parser(prog="sim-movie", description=__doc__.splitlines()[0])
@@ -596,7 +595,7 @@ def main(argv=None):
     parser.add_argument("--color", default="speed", help="speed (default), species or cluster")
     parser.add_argument("--start", type=float, help="time of the first frame (first snapshot)")
     parser.add_argument("--stop", type=float, help="time of the last frame (last snapshot)")
-    previous = signal.signal(signal.SIGTERM, _interrupt)  # SIGTERM cleans up as Ctrl-C does
+    previous = signal.signal(signal.SIGTERM, interrupt)  # SIGTERM cleans up as Ctrl-C does
     try:
         args = parser.parse_args(argv)
         out = make_movie(args.run, args.out, args.fps, args.frames, args.duration, args.color,

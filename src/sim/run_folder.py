@@ -70,6 +70,7 @@ class RunLock:
             fd = os.open(self.file, os.O_RDWR | os.O_CREAT, 0o644)
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                self._fd = fd  # held: from here on __exit__ releases it, even mid-way
             except BlockingIOError:
                 holder = os.read(fd, 32).decode(errors="replace").strip()
                 os.close(fd)
@@ -91,10 +92,10 @@ class RunLock:
                 same = False
             if same:
                 break
+            self._fd = None
             os.close(fd)
         os.ftruncate(fd, 0)
         os.write(fd, str(os.getpid()).encode())
-        self._fd = fd
         # what a run killed before publishing left behind; only the lock's holder writes it
         part_path(self.path).unlink(missing_ok=True)
         return self

@@ -191,11 +191,12 @@ def next_snapshot_time(last_time, every_time):
         return None
     k = last_time / every_time
     nearest = round(k)
-    on_grid = abs(k - nearest) <= 8.0 * np.finfo(float).eps * max(1.0, abs(k))
+    on_grid = abs(k - nearest) <= max(8.0 * np.finfo(float).eps * abs(k), 1e-9)
     next_time = ((nearest if on_grid else math.floor(k)) + 1) * every_time
-    if next_time <= last_time:
+    if next_time <= last_time or math.ulp(next_time) > 1e-6 * every_time:
         raise ConfigError("output.every_time", every_time,
-                          f"a cadence that float64 can add to t = {last_time:.6g}")
+                          f"a cadence that float64 resolves at t = {last_time:.6g}: above "
+                          f"{1e6 * math.ulp(next_time):.3g}")
     return next_time
 
 
@@ -405,16 +406,16 @@ def _locked(path, key):
     process's lock is a :class:`ConfigError` on ``key``, a folder where no lock file can
     be made a :class:`RunFileError`."""
     lock = RunLock(path)
-    try:
-        lock.__enter__()
-    except FolderBusyError as error:
-        what = "run file" if key == "resume" else "folder"
-        raise ConfigError(key, str(path if key == "resume" else path.parent),
-                          f"a {what} that no other run is using: {error.holder} is writing "
-                          f"{path}; wait for it to end, or choose another") from None
-    except OSError as error:
-        raise _cannot_write(path, error) from error
-    try:
+    try:  # released whatever ends the run, a signal inside the taking of the lock included
+        try:
+            lock.__enter__()
+        except FolderBusyError as error:
+            what = "run file" if key == "resume" else "folder"
+            raise ConfigError(key, str(path if key == "resume" else path.parent),
+                              f"a {what} that no other run is using: {error.holder} is "
+                              f"writing {path}; wait for it to end, or choose another") from None
+        except OSError as error:
+            raise _cannot_write(path, error) from error
         yield
     finally:
         lock.__exit__()

@@ -47,7 +47,7 @@ def scene(name, preparation=None):
     saying how it places its disks (default: as the config gives them)."""
     def register(builder):
         BUILDERS[name] = builder
-        PREPARATIONS[name] = preparation or (lambda cfg: "positions and velocities as given")
+        PREPARATIONS[name] = preparation or (lambda cfg: "placed as the scene's keys say")
         return builder
     return register
 
@@ -207,9 +207,9 @@ def _bed(cfg):
 def _bed_preparation(cfg):
     b = cfg.bed
     placed = PLACEMENTS[_placement(cfg, int(b.n), float(b.radius), _bed_region(cfg))]
-    settled = (f", settled for t = {b.settle_time} under gravity"
-               if b.settle_time is not None else "")
-    return f"bed: {placed}{settled}, at rest"
+    if cfg.scene == "crater" and b.settle_time is not None:
+        return f"bed: {placed}, then settled for t = {b.settle_time} under gravity"
+    return f"bed: {placed}, at rest"
 
 
 @scene("vibrated_bed", _bed_preparation)

@@ -28,7 +28,7 @@ from scipy import stats
 
 from sim.analysis import open_sweep
 from sim.crater import calibrated_spacing, crater_area
-from sim.figures.crater_runs import require_stop
+from sim.figures.crater_runs import preparation_of, require_stop
 from sim.figures.style import figure, save
 
 NAME = "fig11_crater_gravity"
@@ -79,7 +79,7 @@ def draw(runs, sweeps, out_dir):
     large = area > projectile_area
     large_fit = stats.linregress(np.log(energy[large]), np.log(area[large]))
     fig, (left, right) = figure(width=10)
-    fig.suptitle(ds.attrs.get("preparation", "preparation not recorded"), fontsize=9)
+    fig.suptitle(preparation_of(ds), fontsize=9)
     curve = np.geomspace(energy.min(), energy.max(), 100)
     left.loglog(energy[opened], area[opened], "o", color="C0", label="largest cavity")
     left.loglog(curve, np.exp(fit.intercept) * curve**fit.slope, "-", color="C0", lw=1,
@@ -107,5 +107,5 @@ def draw(runs, sweeps, out_dir):
                header=f"projectile_speed,impact_energy,largest_cavity_area,final_cavity_area  "
                       f"(fit: exponent {fit.slope:.4f} +- {fit.stderr:.4f}; over cavities "
                       f"larger than the projectile: {large_fit.slope:.4f} +- "
-                      f"{large_fit.stderr:.4f})", comments="")
+                      f"{large_fit.stderr:.4f}; dx {cavities[0][3]:.6g})", comments="")
     return save(fig, out_dir, NAME)

@@ -14,7 +14,7 @@ import numpy as np
 
 from sim.analysis import open_run
 from sim.crater import CraterGeometry, crater_area
-from sim.figures.crater_runs import crater_overrides
+from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import draw_disks, figure, save
 
 NAME = "fig08_crater_grid"
@@ -33,7 +33,7 @@ def draw(runs, sweeps, out_dir):
         t_end = float(ds["time"].values[-1])
         energy = ds["kinetic_energy"].values
         box = ds.attrs["box"]
-        preparation = ds.attrs["preparation"]
+        preparation = preparation_of(ds)
     area, occupied = crater_area(end[geometry.bed], geometry.radius, geometry.dx,
                                  geometry.width, geometry.height)
     grid = occupied.T.astype(float)

@@ -11,14 +11,15 @@ may stop by their collision budget instead, bouncing on the floor).
 
 The fit: log A = log c + α log R + ε over every run that is not floor-limited, ε with one
 variance for all (least squares in log–log, scipy.stats.linregress), α with its standard
-error. What the data show is not one power law: the local exponent d ln A / d ln R (between
-neighbouring radii, in the numbers file) falls as R grows, from above 2 for projectiles a few
-bed disks wide, whose craters are larger than geometric similarity would make them, to near
-1 where the crater reaches down towards the floor. The fitted α is an average over the range,
-not a scaling law; geometric similarity (α = 2, area ∝ mass) would need grains much smaller
-than the projectile and a bed much deeper than the crater. The numbers file gives, per
-radius, the mean area, its standard error over the beds, the number of floor-limited beds,
-the local exponent, and the fit.
+error. The beds of one seed are the same at every radius, so runs at different radii are
+not independent and that error is a lower bound. What the data show is not one power law:
+the local exponent d ln A / d ln R between neighbouring radii (right panel, over the beds
+not floor-limited) falls as R grows, from above 2 for projectiles a few bed disks wide to
+near 1 for larger ones, before any reaches the floor. The fitted α is an average over the
+range, not a scaling law; geometric similarity (α = 2, area ∝ mass) would need grains much
+smaller than the projectile and a bed much deeper than the crater. The numbers file gives,
+per radius, the mean area over the beds not floor-limited, its standard error, the number
+of floor-limited beds, the local exponent to the next radius, and the fit.
 """
 
 import numpy as np
@@ -26,7 +27,7 @@ from scipy import stats
 
 from sim.analysis import at_last_snapshot, open_sweep
 from sim.crater import CraterGeometry
-from sim.figures.crater_runs import crater_overrides
+from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import figure, save
 
 NAME = "fig09_crater_radius"
@@ -80,32 +81,37 @@ def draw(runs, sweeps, out_dir):
     free = ~floor
     radius_of_run = np.broadcast_to(radius[:, None], area.shape)
     fit = stats.linregress(np.log(radius_of_run[free]), np.log(area[free]))
-    mean = area.mean(axis=1)
-    error = area.std(axis=1, ddof=1) / np.sqrt(seed.size)
-    local = np.gradient(np.log(mean), np.log(radius))  # d ln A / d ln R
+    beds = free.sum(axis=1)  # beds not floor-limited, per radius
+    mean = np.array([area[i, free[i]].mean() if beds[i] else np.nan for i in range(radius.size)])
+    error = np.array([area[i, free[i]].std(ddof=1) / np.sqrt(beds[i]) if beds[i] > 1 else np.nan
+                      for i in range(radius.size)])
+    # d ln A / d ln R between neighbouring radii, at their geometric midpoints
+    local = np.log(mean[1:] / mean[:-1]) / np.log(radius[1:] / radius[:-1])
     fig, (left, right) = figure(width=10)
-    curve = np.geomspace(radius[free.any(axis=1)].min(), radius[free.any(axis=1)].max(), 100)
+    curve = np.geomspace(radius[beds > 0].min(), radius[beds > 0].max(), 100)
     left.loglog(radius_of_run[free], area[free], "o", color="C0", ms=4, alpha=0.6, label="one bed")
     if floor.any():
         left.loglog(radius_of_run[floor], area[floor], "o", mfc="none", color="C3", ms=5,
                     label="floor-limited (not fitted)")
     left.loglog(curve, np.exp(fit.intercept) * curve**fit.slope, "-", color="C0", lw=1,
-                label=f"fit A = c R^α: mean α = {fit.slope:.2f} ± {fit.stderr:.2f}")
+                label=f"fit A = c R^α: α = {fit.slope:.2f} ± {fit.stderr:.2f}")
     left.loglog(curve, np.pi * curve**2, "k:", lw=1, label="πR² (the projectile's own area)")
     left.set(xlabel="projectile radius R (box units)", ylabel="crater area A (box units²)",
              title=f"area at 10 % energy left, {seed.size} beds per radius")
     left.legend(fontsize=8)
-    right.errorbar(mass, mean, yerr=error, fmt="o-", color="C1", capsize=3,
-                   label="mean of the beds ± standard error")
-    right.set(xlabel="projectile mass (bed-disk masses)", ylabel="crater area A (box units²)",
-              title="against mass ∝ R²")
+    right.semilogx(np.sqrt(radius[1:] * radius[:-1]), local, "o-", color="C1",
+                   label="between neighbouring radii")
+    right.axhline(2.0, color="k", ls=":", lw=1, label="2: geometric similarity (A ∝ mass)")
+    right.set(xlabel="projectile radius R (box units)", ylabel="local exponent d ln A / d ln R",
+              title="the slope of the left panel, beds not floor-limited")
     right.legend(fontsize=8)
-    fig.suptitle(ds.attrs.get("preparation", "bed preparation not recorded"), fontsize=9)
+    fig.suptitle(preparation_of(ds), fontsize=9)
     header = (f"projectile_radius,projectile_mass,crater_area_mean,crater_area_error,"
-              f"floor_limited_beds,local_exponent  (fit over {int(free.sum())} runs not "
-              f"floor-limited: exponent {fit.slope:.4f} +- {fit.stderr:.4f}, prefactor "
-              f"{np.exp(fit.intercept):.4g})")
+              f"floor_limited_beds,local_exponent_to_next  (means over the beds not "
+              f"floor-limited; fit over those {int(free.sum())} runs: exponent "
+              f"{fit.slope:.4f} +- {fit.stderr:.4f}, prefactor {np.exp(fit.intercept):.4g})")
     np.savetxt(out_dir / f"{NAME}.csv",
-               np.column_stack([radius, mass, mean, error, floor.sum(axis=1), local]),
+               np.column_stack([radius, mass, mean, error, floor.sum(axis=1),
+                                np.append(local, np.nan)]),
                delimiter=",", fmt="%.6g", header=header, comments="")
     return save(fig, out_dir, NAME)

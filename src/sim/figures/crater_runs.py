@@ -2,6 +2,8 @@
 (R = 0.0045, φ ≈ 0.51 in the lower half) or, quick, 1000 disks of twice the radius (the same
 packing fraction)."""
 
+import numpy as np
+
 
 def crater_overrides(quick):
     bed = ["bed.n=1000", "bed.radius=0.009", "output.every_collisions=5000"] if quick else []
@@ -16,3 +18,13 @@ def require_stop(sweep, swept, reason, remedy):
     if unfinished.size:
         raise ValueError(f"runs at {swept} = {unfinished.tolist()} stopped otherwise than by "
                          f"{reason}: {remedy}")
+
+
+def preparation_of(ds):
+    """How the runs of ``ds`` (open_run's or open_sweep's) made their initial state, in words:
+    one text for all, or each distinct one."""
+    if "preparation" in ds:
+        texts = dict.fromkeys(str(t) for t in np.ravel(ds["preparation"].values))
+    else:
+        texts = [ds.attrs.get("preparation", "")]
+    return "; ".join(t for t in texts if t) or "preparation not recorded (an older run file)"

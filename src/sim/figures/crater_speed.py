@@ -25,7 +25,7 @@ import numpy as np
 
 from sim.analysis import open_sweep
 from sim.crater import CraterGeometry
-from sim.figures.crater_runs import crater_overrides
+from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import figure, save
 
 NAME = "fig10_crater_speed"
@@ -55,7 +55,7 @@ def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["speed"])
     v0 = ds["projectile_speed"].values
     fig, (left, middle, right) = figure(ncols=3, width=14, height=4.4)
-    fig.suptitle(ds.attrs.get("preparation", "preparation not recorded"), fontsize=9)
+    fig.suptitle(preparation_of(ds), fontsize=9)
     rows = []
     for k, speed in enumerate(v0):
         one = ds.isel(projectile_speed=k)

@@ -1,7 +1,9 @@
 """Runs and sweeps for the figure stages, each made once per resolved config.
 
-A run lives in ``<root>/<label>-<hash>/run.h5``, the hash taken over its resolved config, so a
-changed config makes a new run and an unchanged one is reused if it finished. Sweeps run as one
+A run lives in ``<root>/<label>-<hash>/run.h5``, the hash taken over its resolved config and
+how its scene is prepared (:func:`sim.scenes.preparation`: a placement that changes under an
+unchanged config, such as ``auto`` becoming a melt, is a new run), so a changed config makes
+a new run and an unchanged one is reused if it finished. Sweeps run as one
 Hydra multirun (``python -m sim … -m``) into ``<root>/<label>-<hash>/``.
 """
 
@@ -17,6 +19,7 @@ from omegaconf import OmegaConf
 from sim.cli import CONF_DIR
 from sim.config import register
 from sim.runner import run
+from sim.scenes import preparation
 
 register()
 
@@ -24,6 +27,11 @@ register()
 def compose_config(overrides):
     with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
         return compose("config", overrides=list(overrides))
+
+
+def _identity(cfg):
+    """What makes a run this run: its resolved config and how its scene is prepared."""
+    return OmegaConf.to_yaml(cfg, resolve=True) + preparation(cfg)
 
 
 def _digest(text):
@@ -34,7 +42,7 @@ def ensure_run(label, overrides, root):
     """The run file of ``overrides`` under ``root``, simulated only if not there yet (a run
     cut short there is resumed, :func:`sim.runner.run`)."""
     cfg = compose_config([*overrides, "output.progress=false"])
-    folder = Path(root) / f"{label}-{_digest(OmegaConf.to_yaml(cfg, resolve=True))}"
+    folder = Path(root) / f"{label}-{_digest(_identity(cfg))}"
     folder.mkdir(parents=True, exist_ok=True)
     return run(cfg, folder)
 
@@ -53,9 +61,8 @@ def ensure_sweep(label, overrides, root):
     it has not completed before: keyed by the overrides and the resolved config of its first
     job, so that a changed scene file makes the sweep again."""
     first_job = [_first_value(o) for o in overrides]
-    resolved = OmegaConf.to_yaml(compose_config([*first_job, "output.progress=false"]),
-                                 resolve=True)
-    key = " ".join(sorted(overrides)) + resolved
+    key = " ".join(sorted(overrides)) + _identity(
+        compose_config([*first_job, "output.progress=false"]))
     folder = Path(root) / f"{label}-{_digest(key)}"
     if not (folder / "sweep_summary.yaml").exists():
         command = [sys.executable, "-m", "sim", *overrides, "output.progress=false",
