@@ -48,7 +48,10 @@ def test_quick_figures(tmp_path):
     assert np.all(grid[:, 2] > np.pi * 0.05**2)  # the crater is larger than the projectile
     assert np.all(grid[:, 2] < 0.5)  # and smaller than the bed
     radius = np.loadtxt(out / "fig09_crater_radius.csv", delimiter=",", skiprows=1)
-    assert np.all(np.diff(radius[:, 2]) > 0)  # larger projectiles dig larger craters
+    # larger projectiles dig larger craters (means over the beds that did not reach the
+    # floor; NaN where every bed did)
+    reached = np.isnan(radius[:, 2])
+    assert np.all(np.diff(radius[~reached, 2]) > 0) and np.all(radius[reached, 4] > 0)
     assert radius[0, 4] == 0  # the smallest projectile stays far above the floor
     speed = np.loadtxt(out / "fig10_crater_speed.csv", delimiter=",", skiprows=1)
     # no energy scale: the same area at every speed, but for the TC model's fixed t_c, which

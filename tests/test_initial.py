@@ -69,8 +69,11 @@ def test_melted_lattice_is_a_fluid_without_overlap():
     fluid = melted_lattice(n, radius, region=region, seed=5)
     assert global_bond_order(crystal, region) > 0.8
     assert global_bond_order(fluid, region) < 3.0 / np.sqrt(n)
-    assert overlapping_pairs(fluid, np.full(n, radius), tolerance=0.0)[0].size == 0
-    assert fluid[:, 1].max() <= 0.5 - radius and fluid.min() >= radius
+    # disks may touch, to round-off, as they do at the melt's last collision (the engine's
+    # own check of its input allows it: 1e-9 of the contact distance)
+    assert overlapping_pairs(fluid, np.full(n, radius))[0].size == 0
+    inner = radius * (1.0 - 1e-9)
+    assert fluid[:, 1].max() <= 0.5 - inner and fluid.min() >= inner
     np.testing.assert_array_equal(fluid, melted_lattice(n, radius, region=region, seed=5))
 
 

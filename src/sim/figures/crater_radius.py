@@ -5,8 +5,9 @@ energy, as in the study, and is measured on the grid of figure 8 (sim.crater), �
 on its own untouched bed.
 
 Floor-limited runs: a projectile whose lowest point comes within ``FLOOR_GAP`` bed-disk
-diameters of the floor before the stop has dug through the bed; its crater is set by the
-box, not by the impact. Those runs are drawn as open symbols and left out of the fit (and
+diameters of the floor before the stop (seen at the snapshots, every 20 000 collisions, in
+which it moves a small fraction of its radius) has dug through the bed; its crater is set
+by the box, not by the impact. Those runs are drawn as open symbols and left out of the fit (and
 may stop by their collision budget instead, bouncing on the floor).
 
 The fit: log A = log c + α log R + ε over every run that is not floor-limited, ε with one
