@@ -23,7 +23,8 @@ import yaml
 
 import sim.export
 from sim.analysis import open_run
-from sim.export import ExportError, export, frame_indices, hoomd_positions, main
+from sim.command import BadInput
+from sim.export import export, frame_indices, hoomd_positions, main
 from sim.figures.runs import compose_config
 from sim.runner import run
 
@@ -152,7 +153,7 @@ def test_the_default_output_is_beside_the_run_file(mixture, tmp_path):
     shutil.copy(mixture, path)
     assert sim_export(path, "--format", "gsd") == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.gsd", "mine.h5"]
-    with pytest.raises(ExportError, match="unknown format 'pdb'"):
+    with pytest.raises(BadInput, match="unknown format 'pdb'"):
         export(path, "pdb")
 
 

@@ -13,12 +13,6 @@ def _stop(signum, frame):
     raise KeyboardInterrupt
 
 
-def interrupt(signum, frame):
-    """Signal handler of the commands: SIGTERM ends them as Ctrl-C does, with a
-    KeyboardInterrupt that carries the signal's number."""
-    raise KeyboardInterrupt(signum)
-
-
 def caused_by_a_signal(error):
     """Whether a KeyboardInterrupt is ``error`` or its cause (Python wraps one raised while
     a class is being made, e.g. in ``__set_name__``)."""

@@ -33,9 +33,7 @@ damaged snapshot among those asked); 1 when the output cannot be written; 130 af
 143 after SIGTERM. Nothing is left behind but a whole file.
 """
 
-import argparse
 import os
-import signal
 import string
 import sys
 import warnings
@@ -44,25 +42,17 @@ from pathlib import Path
 import gsd.hoomd
 import numpy as np
 
-from sim.__main__ import interrupt
 from sim.analysis import open_run
+from sim.command import BadInput, CannotWrite, Parser, run_command
 from sim.inspect import RunFileError
 
 #: the columns of every disk's line in an xyz file
 XYZ_PROPERTIES = "type:I:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1"
 
 
-class ExportError(ValueError):
-    """A request that cannot be exported, said in one line."""
-
-
-class CannotWrite(OSError):
-    """The export file could not be written; nothing of it is left."""
-
-
 def frame_indices(spec, count):
     """The snapshot indices, out of ``count``, that ``spec`` selects (see the module
-    docstring); every one for None. :class:`ExportError` for a spec that is neither form, an
+    docstring); every one for None. :class:`BadInput` for a spec that is neither form, an
     index out of range or a selection of no snapshot."""
     if spec is None:
         indices = range(count)
@@ -77,14 +67,14 @@ def frame_indices(spec, count):
             else:
                 indices = [int(p) for p in spec.split(",")]
         except ValueError:
-            raise ExportError(f"--frames {spec!r}: neither start:stop:step (step not 0) nor a "
+            raise BadInput(f"--frames {spec!r}: neither start:stop:step (step not 0) nor a "
                               f"comma list of snapshot indices") from None
         outside = [i for i in indices if not -count <= i < count]
         if outside:
-            raise ExportError(f"--frames {spec!r}: snapshot {outside[0]} is out of range; the "
+            raise BadInput(f"--frames {spec!r}: snapshot {outside[0]} is out of range; the "
                               f"run has {count} snapshots, 0 to {count - 1}")
     if not indices:
-        raise ExportError(f"--frames {spec!r} selects none of the run's {count} snapshots"
+        raise BadInput(f"--frames {spec!r} selects none of the run's {count} snapshots"
                           if spec is not None else "the run has no snapshots")
     return [i % count for i in indices]
 
@@ -92,7 +82,7 @@ def frame_indices(spec, count):
 def snapshots(run, indices):
     """(step, time, position, velocity) of the snapshots ``indices`` of the open run
     ``run`` (:func:`sim.analysis.open_run`), read one at a time; positions and velocities
-    float64[n, 2]. :class:`ExportError` at a damaged snapshot."""
+    float64[n, 2]. :class:`BadInput` at a damaged snapshot."""
     steps, times = run["step"].values, run["time"].values
     for i in indices:
         with warnings.catch_warnings():
@@ -102,7 +92,7 @@ def snapshots(run, indices):
         step, time = steps[i], times[i]
         if not (np.isfinite(position).all() and np.isfinite(velocity).all()
                 and np.isfinite(step) and np.isfinite(time)):
-            raise ExportError(f"{run.attrs['path']}: snapshot {i} is damaged (sim-inspect names "
+            raise BadInput(f"{run.attrs['path']}: snapshot {i} is damaged (sim-inspect names "
                               f"what); leave it out with --frames")
         yield int(step), float(time), position, velocity
 
@@ -179,10 +169,10 @@ WRITERS = {"gsd": write_gsd, "xyz": write_xyz}
 def export(run_path, fmt, out=None, frames=None):
     """Export the run file ``run_path`` as ``fmt`` (``gsd`` or ``xyz``) to ``out`` (default:
     beside the run file, its suffix replaced), the snapshots ``frames`` selects
-    (:func:`frame_indices`). Returns the path written; :class:`ExportError` or
+    (:func:`frame_indices`). Returns the path written; :class:`BadInput` or
     :class:`sim.inspect.RunFileError` when it cannot be, and then nothing is left behind."""
     if fmt not in WRITERS:
-        raise ExportError(f"unknown format {fmt!r}: {' or '.join(WRITERS)}")
+        raise BadInput(f"unknown format {fmt!r}: {' or '.join(WRITERS)}")
     target = Path(out) if out is not None else Path(run_path).with_suffix(f".{fmt}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # damaged observables: not exported
@@ -190,7 +180,7 @@ def export(run_path, fmt, out=None, frames=None):
     with run:
         indices = frame_indices(frames, run.sizes["time"])
         if target.exists() and target.resolve() == Path(run_path).resolve():
-            raise ExportError(f"--out {target} is the run file itself")
+            raise BadInput(f"--out {target} is the run file itself")
         partial = target.with_name(f".{target.name}.{os.getpid()}.part")
         try:
             WRITERS[fmt](partial, run, snapshots(run, indices))
@@ -204,39 +194,19 @@ def export(run_path, fmt, out=None, frames=None):
     return target
 
 
-class _OneLineParser(argparse.ArgumentParser):
-    """Usage errors as one line on stderr, exit status 2."""
-
-    def error(self, message):
-        self.exit(2, f"{self.prog}: {message}\n")
-
-
 def main(argv=None):
-    parser = _OneLineParser(prog="sim-export",
-                            description="A run's snapshots as GSD or extended XYZ.")
+    parser = Parser(prog="sim-export", description="A run's snapshots as GSD or extended XYZ.")
     parser.add_argument("path", help="run file (run.h5)")
     parser.add_argument("--format", required=True, choices=sorted(WRITERS), dest="fmt")
     parser.add_argument("--out", help="output file (default: beside the run file)")
     parser.add_argument("--frames", help="start:stop:step or a comma list of snapshot indices "
                                          "(default: all), e.g. -5: (the last five) or 0,-1")
-    args = parser.parse_args(argv)
-    previous = signal.signal(signal.SIGTERM, interrupt)  # SIGTERM cleans up as Ctrl-C does
-    try:
+
+    def body():
+        args = parser.parse_args(argv)
         export(args.path, args.fmt, args.out, args.frames)
-    except (RunFileError, ExportError) as error:
-        print(f"sim-export: {' '.join(str(error).split())}", file=sys.stderr)
-        return 2
-    except CannotWrite as error:
-        print(f"sim-export: {' '.join(str(error).split())}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt as error:
-        signum = error.args[0] if error.args else signal.SIGINT
-        how = "terminated" if signum == signal.SIGTERM else "interrupted"
-        print(f"sim-export: {how}; nothing written", file=sys.stderr)
-        return 128 + signum
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-    return 0
+
+    return run_command("sim-export", body, bad_input=(RunFileError,))
 
 
 if __name__ == "__main__":

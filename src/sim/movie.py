@@ -31,10 +31,8 @@ written; 2, with one line on stderr, for bad input (no run file, a value out of 
 after Ctrl-C, 143 after SIGTERM. Nothing but a whole movie is left behind.
 """
 
-import argparse
 import math
 import os
-import signal
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,8 +49,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from PIL import Image
 
-from sim.__main__ import interrupt
 from sim.analysis import open_run
+from sim.command import BadInput, CannotWrite, Parser, run_command
 from sim.gravity import gravity_vector
 from sim.inspect import RunFileError
 from sim.observers import Clusters
@@ -75,10 +73,6 @@ DEFAULT_CLUSTER_GAP = 0.1
 LARGEST_CLUSTER, LARGE_CLUSTER, SMALL_CLUSTER = "tab:red", "0.35", "0.78"
 WALL, THERMAL_WALL, PERIODIC_SIDE = "black", "tab:red", "0.55"
 COLORINGS = ("speed", "species", "cluster")
-
-
-class InputError(ValueError):
-    """Bad input: one line on stderr and exit status 2."""
 
 
 def free_flight(position, velocity, elapsed, gravity=None, box=None, periodic=(False, False)):
@@ -129,7 +123,7 @@ class Snapshots:
         times = ds["time"].values
         self.readable = np.flatnonzero(np.isfinite(times))  # damaged times are NaN
         if not self.readable.size:
-            raise InputError(f"{ds.attrs['path']} holds no readable snapshot")
+            raise BadInput(f"{ds.attrs['path']} holds no readable snapshot")
         self.times = times[self.readable]
         self.config = yaml.safe_load(ds.attrs["config"]) or {}
         self.gravity = gravity_vector(self.config.get("gravity"))
@@ -487,42 +481,42 @@ def write_whole(out, write):
 def frame_times(snapshot_times, fps, frames=None, duration=None, start=None, stop=None):
     """Times float64[F] of the frames, evenly spaced from ``start`` to ``stop`` (default the
     first and last snapshot): ``frames`` of them, or ``duration`` × ``fps``, or one per
-    snapshot in between (at most DEFAULT_MAX_SECONDS of movie). Bad values: InputError."""
+    snapshot in between (at most DEFAULT_MAX_SECONDS of movie). Bad values: BadInput."""
     if not 0.0 < fps <= MAX_FPS:
-        raise InputError(f"--fps {fps}: a frame rate above 0 and at most {MAX_FPS:g}")
+        raise BadInput(f"--fps {fps}: a frame rate above 0 and at most {MAX_FPS:g}")
     first, last = float(snapshot_times[0]), float(snapshot_times[-1])
     start = first if start is None else start
     stop = last if stop is None else stop
     if not first <= start <= stop <= last:
-        raise InputError(f"--start {start:.6g} and --stop {stop:.6g}: the run's snapshots span "
+        raise BadInput(f"--start {start:.6g} and --stop {stop:.6g}: the run's snapshots span "
                          f"t = {first:.6g} to {last:.6g}; a frame is drawn only from a snapshot "
                          f"before it, so give {first:.6g} ≤ start ≤ stop ≤ {last:.6g}")
     if duration is not None:
         if not 0.0 < duration < math.inf:
-            raise InputError(f"--duration {duration}: seconds of movie, above 0")
+            raise BadInput(f"--duration {duration}: seconds of movie, above 0")
         frames = round(duration * fps)
         if frames < 1:
-            raise InputError(f"--duration {duration} at --fps {fps:g} is less than one frame")
+            raise BadInput(f"--duration {duration} at --fps {fps:g} is less than one frame")
     elif frames is None:
         inside = snapshot_times[(snapshot_times >= start) & (snapshot_times <= stop)]
         distinct = int(np.sum(np.diff(inside) > round_off(snapshot_times))) + 1
         frames = max(1 if start == stop else 2, min(distinct, round(DEFAULT_MAX_SECONDS * fps)))
     if frames < 1:
-        raise InputError(f"--frames {frames}: at least one frame")
+        raise BadInput(f"--frames {frames}: at least one frame")
     if frames > 1 and start == stop:
-        raise InputError(f"--start and --stop are both {start:.6g}: one frame only "
+        raise BadInput(f"--start and --stop are both {start:.6g}: one frame only "
                          f"(--frames 1)")
     return np.linspace(start, stop, frames)
 
 
 def _output(run_path, out):
-    """The movie's path: ``out``, or the run file's with .mp4; InputError for a name that is
+    """The movie's path: ``out``, or the run file's with .mp4; BadInput for a name that is
     neither .mp4 nor .gif or a folder that does not exist."""
     out = Path(run_path).with_suffix(".mp4") if out is None else Path(out)
     if out.suffix.lower() not in (".mp4", ".gif"):
-        raise InputError(f"--out {out}: a movie name ending in .mp4 or .gif")
+        raise BadInput(f"--out {out}: a movie name ending in .mp4 or .gif")
     if not out.parent.is_dir():
-        raise InputError(f"--out {out}: no folder {out.parent}")
+        raise BadInput(f"--out {out}: no folder {out.parent}")
     return out
 
 
@@ -531,10 +525,10 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
     """Write the movie of the run file ``run_path`` (the command's options as arguments) and
     return its path: ``out``, or the same name with .gif when ffmpeg is unavailable. Notes (a
     GIF instead of an MP4, frames drawn across contacts) go to ``note``, one line each.
-    InputError or :class:`sim.inspect.RunFileError` for bad input, OSError when the movie
+    BadInput or :class:`sim.inspect.RunFileError` for bad input, OSError when the movie
     cannot be written."""
     if color not in COLORINGS:
-        raise InputError(f"--color {color}: one of {', '.join(COLORINGS)}")
+        raise BadInput(f"--color {color}: one of {', '.join(COLORINGS)}")
     out = _output(run_path, out)
     with open_run(run_path) as ds:
         snapshots = Snapshots(ds)
@@ -576,16 +570,8 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
     return out
 
 
-class _Parser(argparse.ArgumentParser):
-    """Argument errors as InputError: one line, not usage and a message."""
-
-    def error(self, message):
-        raise InputError(message)
-
-
-
 def main(argv=None):
-    parser = _Parser(prog="sim-movie", description=__doc__.splitlines()[0])
+    parser = Parser(prog="sim-movie", description=__doc__.splitlines()[0])
     parser.add_argument("run", help="run file (run.h5)")
     parser.add_argument("--out", help="movie file, .mp4 or .gif (default: RUN with .mp4)")
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second (30)")
@@ -595,28 +581,19 @@ def main(argv=None):
     parser.add_argument("--color", default="speed", help="speed (default), species or cluster")
     parser.add_argument("--start", type=float, help="time of the first frame (first snapshot)")
     parser.add_argument("--stop", type=float, help="time of the last frame (last snapshot)")
-    previous = signal.signal(signal.SIGTERM, interrupt)  # SIGTERM cleans up as Ctrl-C does
-    try:
+
+    def body():
         args = parser.parse_args(argv)
-        out = make_movie(args.run, args.out, args.fps, args.frames, args.duration, args.color,
-                         args.start, args.stop,
-                         note=lambda line: print(line, file=sys.stderr, flush=True))
-    except (InputError, RunFileError) as error:
-        print(f"sim-movie: {' '.join(str(error).split())}", file=sys.stderr)
-        return 2
-    except OSError as error:
-        reason = str(error).strip().splitlines()[0] if str(error).strip() else repr(error)
-        print(f"sim-movie: the movie could not be written: {reason}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt as error:
-        signum = error.args[0] if error.args else signal.SIGINT
-        how = "terminated" if signum == signal.SIGTERM else "interrupted"
-        print(f"sim-movie: {how}; no movie written", file=sys.stderr)
-        return 128 + signum
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-    print(f"sim-movie: wrote {out}")
-    return 0
+        try:
+            out = make_movie(args.run, args.out, args.fps, args.frames, args.duration,
+                             args.color, args.start, args.stop,
+                             note=lambda line: print(line, file=sys.stderr, flush=True))
+        except OSError as error:
+            reason = str(error).strip().splitlines()[0] if str(error).strip() else repr(error)
+            raise CannotWrite(f"the movie could not be written: {reason}") from error
+        print(f"sim-movie: wrote {out}")
+
+    return run_command("sim-movie", body, bad_input=(RunFileError,), unwritten="no movie written")
 
 
 if __name__ == "__main__":
