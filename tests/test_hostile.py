@@ -780,6 +780,9 @@ def test_sigterm_ends_a_run_resumably_and_resume_finishes_it(tmp_path):
 SELF_INTERRUPTED = """
 import importlib.abc, os, runpy, signal, sys
 moment = sys.argv.pop(1)
+# Ctrl-C as at a terminal, also where the tests were started with SIGINT ignored (a
+# background job of a script), which Python would otherwise keep ignoring
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def interrupt():
