@@ -87,10 +87,15 @@ def draw(runs, sweeps, out_dir):
     error = np.array([area[i, free[i]].std(ddof=1) / np.sqrt(beds[i]) if beds[i] > 1 else np.nan
                       for i in range(radius.size)])
     # d ln A / d ln R between neighbouring radii, at their geometric midpoints
-    local = np.log(mean[1:] / mean[:-1]) / np.log(radius[1:] / radius[:-1])
+    step = np.log(radius[1:] / radius[:-1])
+    local = np.log(mean[1:] / mean[:-1]) / step
+    relative = error / mean
+    local_error = np.hypot(relative[1:], relative[:-1]) / step
     fig, (left, right) = figure(width=10)
     curve = np.geomspace(radius[beds > 0].min(), radius[beds > 0].max(), 100)
-    left.loglog(radius_of_run[free], area[free], "o", color="C0", ms=4, alpha=0.6, label="one bed")
+    left.loglog(radius_of_run[free], area[free], "o", color="C0", ms=3, alpha=0.4, label="one bed")
+    left.errorbar(radius, mean, yerr=error, fmt="s", color="C0", ms=5, capsize=3,
+                  label="mean of the beds ± standard error")
     if floor.any():
         left.loglog(radius_of_run[floor], area[floor], "o", mfc="none", color="C3", ms=5,
                     label="floor-limited (not fitted)")
@@ -100,19 +105,20 @@ def draw(runs, sweeps, out_dir):
     left.set(xlabel="projectile radius R (box units)", ylabel="crater area A (box units²)",
              title=f"area at 10 % energy left, {seed.size} beds per radius")
     left.legend(fontsize=8)
-    right.semilogx(np.sqrt(radius[1:] * radius[:-1]), local, "o-", color="C1",
-                   label="between neighbouring radii")
+    right.errorbar(np.sqrt(radius[1:] * radius[:-1]), local, yerr=local_error, fmt="o-",
+                   color="C1", capsize=3, label="between neighbouring radii")
+    right.set_xscale("log")
     right.axhline(2.0, color="k", ls=":", lw=1, label="2: geometric similarity (A ∝ mass)")
     right.set(xlabel="projectile radius R (box units)", ylabel="local exponent d ln A / d ln R",
               title="the slope of the left panel, beds not floor-limited")
     right.legend(fontsize=8)
     fig.suptitle(preparation_of(ds), fontsize=9)
     header = (f"projectile_radius,projectile_mass,crater_area_mean,crater_area_error,"
-              f"floor_limited_beds,local_exponent_to_next  (means over the beds not "
+              f"floor_limited_beds,local_exponent_to_next,its_error  (means over the beds not "
               f"floor-limited; fit over those {int(free.sum())} runs: exponent "
               f"{fit.slope:.4f} +- {fit.stderr:.4f}, prefactor {np.exp(fit.intercept):.4g})")
     np.savetxt(out_dir / f"{NAME}.csv",
                np.column_stack([radius, mass, mean, error, floor.sum(axis=1),
-                                np.append(local, np.nan)]),
+                                np.append(local, np.nan), np.append(local_error, np.nan)]),
                delimiter=",", fmt="%.6g", header=header, comments="")
     return save(fig, out_dir, NAME)
