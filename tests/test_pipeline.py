@@ -213,6 +213,18 @@ def test_inspect_names_the_boundary_and_the_observables(tmp_path):
     assert {"clusters", "kinetic_energy", "collisions"} <= set(info["observables"])
 
 
+@pytest.mark.parametrize("form", [[], ["--json"]])
+def test_inspect_into_a_pipe_its_reader_closed_is_quiet(form, tmp_path):
+    """``sim-inspect run.h5 | head -1``: the reader gone, the rest is dropped without a
+    traceback. The read end is closed before the command has imported what it needs."""
+    path = runner.run(compose_scene("gas", "stop.collisions=500"), tmp_path)
+    with subprocess.Popen([sys.executable, "-m", "sim.inspect", str(path), *form],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        process.stdout.close()
+        err = process.stderr.read()
+        assert process.wait(timeout=300) == 0 and err == ""
+
+
 def test_open_sweep_pads_shorter_runs_and_keeps_counters_integer(tmp_path):
     for k, collisions in enumerate((1500, 3000)):
         overrides = [f"stop.collisions={collisions}"]

@@ -199,8 +199,9 @@ def main(argv=None):
     parser.add_argument("path", help="run file (run.h5)")
     parser.add_argument("--format", required=True, choices=sorted(WRITERS), dest="fmt")
     parser.add_argument("--out", help="output file (default: beside the run file)")
-    parser.add_argument("--frames", help="start:stop:step or a comma list of snapshot indices "
-                                         "(default: all), e.g. -5: (the last five) or 0,-1")
+    parser.add_argument("--frames", help="start:stop:step or a comma list of snapshot "
+                        "indices (default: all), e.g. --frames=-5: (the last five; with '=', "
+                        "as it starts with '-') or --frames 0,-1")
 
     def body():
         args = parser.parse_args(argv)

@@ -325,14 +325,17 @@ def main(argv=None):
         print(f"sim-inspect: {' '.join(str(error).split())}", file=sys.stderr)
         return 2
     status = 1 if info["damaged"] else 0
-    if args.json:
-        print(json.dumps(info))
-        return status
     text = dict(info, checksums=CHECKSUMS[info["checksums"]],
                 damaged="; ".join(describe(entry) for entry in info["damaged"]) or "nothing")
     width = max(len(k) for k in text)
-    for key, value in text.items():
-        print(f"{key:<{width}}  {value}")
+    try:
+        if args.json:
+            print(json.dumps(info), flush=True)
+        else:
+            for key, value in text.items():
+                print(f"{key:<{width}}  {value}", flush=True)
+    except BrokenPipeError:  # a reader that stopped early (| head): the rest is not wanted
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return status
 
 
