@@ -3,7 +3,7 @@
 A row (:class:`Check`) holds the measured value, the reference and its source, the tolerance
 the comparison allows and why, whether it passed, and the wall-clock seconds of its run.
 ``tests/test_validation.py`` runs every study as a slow test and writes the table to
-``outputs/validation/`` (``make validate``). Formulas and sources: ../shared/physics.md, and
+``outputs/validation/`` (``make validate``). Each study's docstring gives its formula and source;
 for the dense fluid the equation of state of Kolafa & Rottner, Mol. Phys. 104, 3435 (2006).
 
 Units: k_B = 1, unit masses unless stated, 2D temperature T = E_kin/(N − 1) when the total
