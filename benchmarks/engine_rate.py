@@ -24,9 +24,14 @@ import time
 
 import numpy as np
 
-from sim.engine import Boundary, Engine
-from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
-from sim.reference import ReferenceEngine
+from sim.checks.reference import ReferenceEngine
+from sim.engine.core import Boundary, Engine
+from sim.pipeline.initial import (
+    fixed_speed,
+    hexagonal_lattice,
+    radius_for_packing,
+    random_sequential,
+)
 
 FIRST_CALL = {"seconds": None}
 

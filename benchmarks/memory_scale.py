@@ -17,9 +17,9 @@ import tempfile
 import threading
 import time
 
-from sim import runner
 from sim.figures.runs import compose_config
-from sim.h5md import RunWriter
+from sim.pipeline import runner
+from sim.storage.h5md import RunWriter
 
 
 def rss_bytes():

@@ -25,15 +25,15 @@ import numpy as np
 from numba import njit
 
 from engine_rate import equal_disks
-from sim.engine import Boundary, Engine, shell_ratio
-from sim.event_queue import build_queue, earliest, empty_queue, reschedule
-from sim.kinematics import (
+from sim.engine.core import Boundary, Engine, shell_ratio
+from sim.engine.kinematics import (
     may_touch_before,
     minimum_image,
     pair_contact_time,
     shell_exit_time,
     wrap,
 )
+from sim.engine.queue import build_queue, earliest, empty_queue, reschedule
 
 SHELL_EXIT = -2
 

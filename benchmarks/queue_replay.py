@@ -1,6 +1,6 @@
 """What the event queue alone costs, by N: a replay of the engine's queue operations.
 
-Each step does what a disk–disk collision does to the queue (sim.event_queue): the earliest
+Each step does what a disk–disk collision does to the queue (sim.engine.queue): the earliest
 disk is taken, given a new event an exponential delay later and rescheduled, and a partner
 near it in memory (within ±32 ids, as disks renumbered by cell are) is rescheduled too, to
 an exponential delay after the current time. Mean delay 1 for n disks: the engine's rate of
@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from engine_rate import emit
-from sim.event_queue import build_queue, earliest, empty_queue, reschedule
+from sim.engine.queue import build_queue, earliest, empty_queue, reschedule
 
 #: Partners are drawn within ±NEIGHBOUR_SPAN / 2 ids of the disk.
 NEIGHBOUR_SPAN = 64

@@ -7,10 +7,15 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-from sim.audit import outside_box, overlapping_pairs
-from sim.engine import Boundary, Engine
-from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
-from sim.validation import table
+from sim.checks.audit import outside_box, overlapping_pairs
+from sim.checks.validation import table
+from sim.engine.core import Boundary, Engine
+from sim.pipeline.initial import (
+    fixed_speed,
+    hexagonal_lattice,
+    radius_for_packing,
+    random_sequential,
+)
 
 #: Tests never depend on the clock: no example has a deadline (the first example of a test
 #: compiles numba code, and a loaded machine runs anything slowly).
@@ -52,7 +57,7 @@ _validation_rows = []
 
 @pytest.fixture
 def validation_rows():
-    """Rows of the validation table (sim.validation.Check), collected over the session."""
+    """Rows of the validation table (sim.checks.validation.Check), collected over the session."""
     return _validation_rows
 
 

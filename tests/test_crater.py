@@ -7,12 +7,18 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sim.analysis import open_run
-from sim.crater import CraterGeometry, area, calibrated_spacing, crater_area, occupied_cells
-from sim.engine import Engine
+from sim.analysis.crater import (
+    CraterGeometry,
+    area,
+    calibrated_spacing,
+    crater_area,
+    occupied_cells,
+)
+from sim.analysis.datasets import open_run
+from sim.engine.core import Engine
 from sim.figures.runs import compose_config
-from sim.initial import hexagonal_lattice
-from sim.runner import run
+from sim.pipeline.initial import hexagonal_lattice
+from sim.pipeline.runner import run
 
 
 def overlaps_by_figure_1(cx, cy, radius, x0, y0, x1, y1):
@@ -88,7 +94,7 @@ def test_a_crater_at_twice_the_speed_is_the_same_crater_in_half_the_time():
 
 
 def test_the_area_of_a_run_in_one_call(tmp_path):
-    """sim.crater.area(path) is the area of the last snapshot on the grid calibrated on the
+    """sim.analysis.crater.area(path) is the area of the last snapshot on the grid calibrated on the
     first, and the same from an open Dataset; the first snapshot's bed has no crater."""
     cfg = compose_config(["scenario=crater", "bed.n=300", "bed.radius=0.016",
                           "stop.collisions=3000", "output.every_collisions=1000",

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from conftest import assert_no_overlap, gas
-from sim.audit import overlapping_pairs
-from sim.engine import (
+from sim.checks.audit import overlapping_pairs
+from sim.engine.core import (
     LIST_GROWTH,
     Boundary,
     Engine,
@@ -16,10 +16,10 @@ from sim.engine import (
     packing_fraction_around_disks,
     shell_ratio,
 )
-from sim.event_loop import SHELL_EXITS, STALE_EVENTS
-from sim.initial import PlacementError, hexagonal_lattice, random_sequential
-from sim.kinematics import DISK_COLUMNS, VX, VY, X, Y
-from sim.neighbours import shell_centre
+from sim.engine.kinematics import DISK_COLUMNS, VX, VY, X, Y
+from sim.engine.loop import SHELL_EXITS, STALE_EVENTS
+from sim.engine.neighbours import shell_centre
+from sim.pipeline.initial import PlacementError, hexagonal_lattice, random_sequential
 
 
 def triangle_wave(s, low, high):
@@ -205,7 +205,7 @@ def state_buffer_span(disks):
 
 
 def test_state_stays_in_one_buffer_through_renumbering_and_list_growth():
-    """One buffer, on a 2 MiB boundary, each array on a cache line (sim.state.one_buffer),
+    """One buffer, on a 2 MiB boundary, each array on a cache line (sim.engine.state.one_buffer),
     also after a renumbering and after the lists grow."""
     engine = gas(800, 0.6, (True, True), seed=37, list_capacity=1)
     for change in (lambda: None, engine.reorder, lambda: engine._grow_lists(0)):
@@ -256,7 +256,7 @@ def test_shell_centre_leads_its_disk_by_a_fraction_of_the_shell():
 
 @pytest.mark.parametrize("periodic", [(True, True), (False, False)])
 def test_shells_ahead_of_their_disks_save_exits_and_change_no_physics(periodic):
-    """A new shell centred λ δ ahead of its disk (:func:`sim.neighbours.shell_centre`): in a
+    """A new shell centred λ δ ahead of its disk (:func:`sim.engine.neighbours.shell_centre`): in a
     dilute gas fewer shell exits per collision than with shells centred on the disk (at
     φ = 0.1, N = 1e4: 2.09 against 1.47 for λ = 0.7 and 1.41 for 0.85), the same collisions
     at the same times, no overlap."""

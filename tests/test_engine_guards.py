@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import assert_no_overlap, gas
-from sim.engine import (
+from sim.engine.core import (
     TIMED_FIRST_CHUNK,
     Boundary,
     ClosedBoxError,
@@ -20,7 +20,12 @@ from sim.engine import (
     first_overlap,
     grid_cells,
 )
-from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
+from sim.pipeline.initial import (
+    fixed_speed,
+    hexagonal_lattice,
+    radius_for_packing,
+    random_sequential,
+)
 
 
 def refused(match, *args, **options):
@@ -33,7 +38,7 @@ def refused(match, *args, **options):
 
 # -- 1. the input is checked ----------------------------------------------------------------
 def brute_first_overlap(position, radius, box, periodic, tolerance=1e-9):
-    """The definition of :func:`sim.engine.first_overlap`, pair by pair."""
+    """The definition of :func:`sim.engine.core.first_overlap`, pair by pair."""
     for i in range(len(radius)):
         r = position[i] - position[:i]
         r -= np.where(periodic, box * np.round(r / box), 0.0)

@@ -1,4 +1,4 @@
-"""The calendar queue stays what :mod:`sim.event_queue` says it is while the engine runs:
+"""The calendar queue stays what :mod:`sim.engine.queue` says it is while the engine runs:
 a valid heap of the current block's events, every other event in the bucket of its block or
 in the overflow list, each disk queued exactly once, and no listed event before a heap event.
 """
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from sim.engine import Boundary, Engine
-from sim.event_queue import CURRENT_BLOCK, HEAP_SIZE, NEXT, NOT_IN_HEAP, PREV, SLOT, YEAR_END
-from sim.initial import fixed_speed, random_sequential
+from sim.engine.core import Boundary, Engine
+from sim.engine.queue import CURRENT_BLOCK, HEAP_SIZE, NEXT, NOT_IN_HEAP, PREV, SLOT, YEAR_END
+from sim.pipeline.initial import fixed_speed, random_sequential
 
 
 def assert_queue_consistent(disks):

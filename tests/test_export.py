@@ -1,4 +1,4 @@
-"""sim.export: GSD and extended XYZ files read back to what the run file holds, frame
+"""sim.storage.export: GSD and extended XYZ files read back to what the run file holds, frame
 selections, one-line refusals that leave nothing behind, and freud's g(r) of the exported
 GSD frames against the run's own ``radial_distribution`` observer.
 
@@ -21,12 +21,12 @@ import numpy as np
 import pytest
 import yaml
 
-import sim.export
-from sim.analysis import open_run
-from sim.command import BadInput
-from sim.export import export, frame_indices, hoomd_positions, main
+import sim.storage.export
+from sim.analysis.datasets import open_run
 from sim.figures.runs import compose_config
-from sim.runner import run
+from sim.pipeline.command import BadInput
+from sim.pipeline.runner import run
+from sim.storage.export import export, frame_indices, hoomd_positions, main
 
 
 def make_run(folder, *overrides):
@@ -217,7 +217,7 @@ def test_a_signal_during_the_export_leaves_nothing(signum, mixture, tmp_path, mo
         path.write_bytes(b"half a file")
         raise KeyboardInterrupt(signum)
 
-    monkeypatch.setitem(sim.export.WRITERS, "gsd", interrupted)
+    monkeypatch.setitem(sim.storage.export.WRITERS, "gsd", interrupted)
     capsys.readouterr()
     assert sim_export(mixture, "--format", "gsd", "--out", tmp_path / "x.gsd") == 128 + signum
     _, err = capsys.readouterr()
@@ -226,7 +226,7 @@ def test_a_signal_during_the_export_leaves_nothing(signum, mixture, tmp_path, mo
 
 
 def test_the_command_refuses_in_one_line(tmp_path):
-    done = subprocess.run([sys.executable, "-m", "sim.export", str(tmp_path / "nope.h5"),
+    done = subprocess.run([sys.executable, "-m", "sim.storage.export", str(tmp_path / "nope.h5"),
                            "--format", "gsd"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2
     assert done.stderr == f"sim-export: {tmp_path / 'nope.h5'}: no such file\n"

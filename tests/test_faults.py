@@ -12,10 +12,10 @@ import h5py
 import numpy as np
 import pytest
 
-import sim.h5md
-from sim import runner
+import sim.storage.h5md
 from sim.figures.runs import compose_config
-from sim.inspect import summary
+from sim.pipeline import runner
+from sim.storage.inspect import summary
 
 #: a gas that runs for a few seconds, to be killed in the middle: 2000 disks, 300 snapshots;
 #: frames are flushed at least every second, and only the first snapshot is checkpointed
@@ -108,9 +108,9 @@ def test_a_disk_that_fills_up_stops_the_run_before_a_write_and_keeps_the_file(
 
     def filling_up(folder):
         calls["n"] += 1
-        return 10**12 if calls["n"] <= 3 else sim.h5md.DISK_MARGIN_BYTES // 2
+        return 10**12 if calls["n"] <= 3 else sim.storage.h5md.DISK_MARGIN_BYTES // 2
 
-    monkeypatch.setattr(sim.h5md, "free_bytes", filling_up)
+    monkeypatch.setattr(sim.storage.h5md, "free_bytes", filling_up)
     cfg = compose_config(["disks.n=500", "stop.collisions=200000",
                           "output.every_collisions=1000", "output.progress=false"])
     with pytest.raises(runner.RunFileError, match="free some room and resume"):
@@ -148,9 +148,9 @@ UNFORESEEN_LIMIT = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
 resource.setrlimit(resource.RLIMIT_FSIZE, (4 << 20, 4 << 20))
-import sim.h5md
-sim.h5md.size_limit = lambda: float("inf")
-from sim.cli import main
+import sim.storage.h5md
+sim.storage.h5md.size_limit = lambda: float("inf")
+from sim.pipeline.cli import main
 sys.argv = ["sim", *sys.argv[1:]]
 main()
 """
@@ -170,7 +170,7 @@ def test_a_write_the_system_refuses_unforeseen_ends_with_one_line(tmp_path):
 #: passed over, so the command must still say it, in one line, at exit
 UNREPORTED_FAILURE = """
 import atexit, sys
-from sim import cli
+from sim.pipeline import cli
 sys.excepthook = cli._quiet_hdf5_traceback
 atexit.register(cli._report_passed_over)
 raise OSError("Driver write request failed (file write failed: errno = 27, "

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import gas, assert_no_overlap
-from test_pipeline import SCENARIOS, compose_scene
 
-from sim.engine import Boundary, Engine
-from sim.runner import build_engine
+from conftest import assert_no_overlap, gas
+from sim.engine.core import Boundary, Engine
+from sim.pipeline.runner import build_engine
+from test_pipeline import SCENARIOS, compose_scene
 
 FINGERPRINTS = Path(__file__).with_name("fingerprints.json")
 RECORD = os.environ.get("SIM_RECORD_FINGERPRINTS") == "1"

@@ -10,9 +10,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import assert_no_overlap, gas
-from sim.audit import overlapping_pairs
-from sim.engine import Boundary, Engine, InelasticCollapseError
-from sim.initial import fixed_speed, hexagonal_lattice, radius_for_packing, random_sequential
+from sim.checks.audit import overlapping_pairs
+from sim.engine.core import Boundary, Engine, InelasticCollapseError
+from sim.pipeline.initial import (
+    fixed_speed,
+    hexagonal_lattice,
+    radius_for_packing,
+    random_sequential,
+)
 
 MILLION = 1_000_000
 

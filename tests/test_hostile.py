@@ -1,11 +1,11 @@
 """Hostile cases: what a careless, unlucky or malicious user does to ``python -m sim``.
 
-Every case asserts the documented outcome (``sim/cli.py``: exit status 0, 1, 2, 3, 130
+Every case asserts the documented outcome (``sim/pipeline/cli.py``: exit status 0, 1, 2, 3, 130
 or 143), that stderr is one line naming the key, path or cause and never a traceback, that a
 refusal (exit 2) leaves nothing behind anywhere under the test's folder (hidden files and
 empty folders included) and that every file there before the case is unchanged (sha256).
 
-Refusals made before Hydra starts run in-process (``sim.cli.main``); whatever runs Hydra,
+Refusals made before Hydra starts run in-process (``sim.pipeline.cli.main``); whatever runs Hydra,
 the engine, signals or several processes runs as real subprocesses, each with a generous hang
 guard (``timeout=``). No assertion depends on elapsed time.
 """
@@ -26,8 +26,8 @@ import numpy as np
 import pytest
 import yaml
 
-from sim import runner
-from sim.inspect import summary
+from sim.pipeline import runner
+from sim.storage.inspect import summary
 
 PY = sys.executable
 HANG_GUARD = 300  # seconds; a guard against hangs, never a measure of speed
@@ -156,9 +156,9 @@ class HydraReached(Exception):
 
 @pytest.fixture
 def entry(monkeypatch, capsys, tmp_path):
-    """``sim.cli.main()`` in this process, in ``tmp_path``, stopped (HydraReached) if it
+    """``sim.pipeline.cli.main()`` in this process, in ``tmp_path``, stopped (HydraReached) if it
     gets as far as Hydra; returns a function of the command line giving a :class:`Result`."""
-    import sim.cli as main_module
+    import sim.pipeline.cli as main_module
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(main_module, "MADE_FOLDERS", [])
@@ -422,12 +422,12 @@ def test_resume_of_what_is_not_a_run_file_is_refused(case, entry, small_run, tmp
 
 
 # ---------------------------------------------------------------------------------------
-# sim.inspect of what is not a run file: exit 2, one line naming the path
+# sim.storage.inspect of what is not a run file: exit 2, one line naming the path
 
 
 @pytest.mark.parametrize("case", list(BAD_RESUME), ids=list(BAD_RESUME))
 def test_inspect_of_what_is_not_a_run_file_is_one_line(case, small_run, tmp_path, capsys):
-    from sim import inspect
+    from sim.storage import inspect
 
     good = copy_run(small_run, tmp_path)
     target = BAD_RESUME[case](tmp_path, good)
@@ -527,7 +527,7 @@ def test_a_second_run_into_a_live_runs_folder_is_refused(live_run):
 
 def test_inspect_of_a_live_run_file_is_one_line(live_run):
     process, folder = live_run
-    done = subprocess.run([PY, "-m", "sim.inspect", str(folder / "X" / "run.h5")],
+    done = subprocess.run([PY, "-m", "sim.storage.inspect", str(folder / "X" / "run.h5")],
                           cwd=folder, capture_output=True, text=True, timeout=HANG_GUARD)
     check(Result(done.returncode, done.stdout, done.stderr), 2, ["run.h5"])
 
@@ -614,7 +614,7 @@ def test_another_sweep_into_a_sweep_folder_is_refused_before_any_job(tmp_path):
 
 
 def test_the_same_sweep_again_changes_nothing_and_reads_back_labelled(tmp_path):
-    from sim.analysis import open_sweep
+    from sim.analysis.datasets import open_sweep
 
     finished_sweep(tmp_path)
     before = tree(tmp_path)
@@ -798,15 +798,15 @@ class AtImport(importlib.abc.MetaPathFinder):
 
 
 if moment == "locked":
-    import sim.run_folder
-    take = sim.run_folder.RunLock.__enter__
+    import sim.pipeline.run_folder
+    take = sim.pipeline.run_folder.RunLock.__enter__
 
     def taken(lock):
         take(lock)
         interrupt()
         return lock
 
-    sim.run_folder.RunLock.__enter__ = taken
+    sim.pipeline.run_folder.RunLock.__enter__ = taken
 else:
     sys.meta_path.insert(0, AtImport())
 sys.argv = ["sim", *sys.argv[1:]]
@@ -814,7 +814,7 @@ runpy.run_module("sim", run_name="__main__")
 """
 
 #: while the modules the command line needs are imported, and once its run folder is locked
-STARTUP_MOMENTS = ["hydra", "numba", "h5py", "sim.engine", "locked"]
+STARTUP_MOMENTS = ["hydra", "numba", "h5py", "sim.engine.core", "locked"]
 
 
 @pytest.mark.parametrize("moment", STARTUP_MOMENTS)
@@ -895,7 +895,7 @@ def _engine_case(name):
 @pytest.mark.parametrize("name", ["overlap", "outside", "nan-velocity", "nan-position",
                                   "inf-velocity"])
 def test_the_engine_refuses_a_bad_disk_naming_it(name):
-    from sim.engine import Engine
+    from sim.engine.core import Engine
 
     position, velocity = _engine_case(name)
     with pytest.raises(ValueError) as error:
@@ -907,7 +907,7 @@ def test_the_engine_refuses_a_bad_disk_naming_it(name):
 
 
 def test_the_engine_refuses_a_bad_mass_or_radius_naming_the_disk():
-    from sim.engine import Engine
+    from sim.engine.core import Engine
 
     position, velocity = _engine_case("none")
     for options in ({"mass": [1.0, float("inf"), 1.0]}, {"mass": [1.0, -1.0, 1.0]}):

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from sim.audit import outside_box, overlapping_pairs
-from sim.initial import (
+from sim.checks.audit import outside_box, overlapping_pairs
+from sim.pipeline.initial import (
     PlacementError,
     fixed_speed,
     hexagonal_lattice,

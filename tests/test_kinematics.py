@@ -6,7 +6,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from sim.kinematics import (
+from sim.engine.kinematics import (
     may_touch_before,
     pair_contact_time,
     shell_exit_time,

@@ -1,5 +1,5 @@
-"""Movies of runs (sim.movie): frames evenly spaced in time, disks in free flight from the latest
-snapshot, drawn where the positions say; MP4 or GIF written whole; bad input is one line and
+"""Movies of runs (sim.figures.movie): frames evenly spaced in time, disks in free flight from the
+latest snapshot, drawn where the positions say; MP4 or GIF written whole; bad input is one line and
 exit status 2."""
 
 import warnings
@@ -10,10 +10,10 @@ import pytest
 from PIL import Image
 from scipy import ndimage
 
-from sim import movie
-from sim.analysis import open_run
+from sim.analysis.datasets import open_run
+from sim.figures import movie
 from sim.figures.runs import compose_config
-from sim.runner import run
+from sim.pipeline.runner import run
 
 #: the two disks of the two_disks scene, their snapshots 0.01 apart
 TWO_DISKS = ["scenario=two_disks", "stop.time=2", "output.every_time=0.01",

@@ -1,12 +1,13 @@
-"""Observers chosen by the scene (sim.observers), written into the run file and read back."""
+"""Observers chosen by the scene (sim.analysis.observers), written into the run file and read
+back."""
 
 import numpy as np
 import pytest
 
-from sim.analysis import contacts, open_run, pressure_tensor
+from sim.analysis.datasets import contacts, open_run, pressure_tensor
+from sim.checks.validation import kolafa_rottner_z
 from sim.figures.runs import compose_config
-from sim.runner import run
-from sim.validation import kolafa_rottner_z
+from sim.pipeline.runner import run
 
 
 def test_radial_distribution_of_a_dense_gas(tmp_path):
@@ -75,8 +76,8 @@ def periodic_gas(tmp_path, *overrides):
 def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
     """The windings the loop counts agree with unwrapping snapshots so close in time that no
     disk moves half a box between them; a lone disk is ballistic across many box lengths."""
-    from sim.engine import Boundary, Engine
-    from sim.initial import radius_for_packing, random_sequential
+    from sim.engine.core import Boundary, Engine
+    from sim.pipeline.initial import radius_for_packing, random_sequential
 
     n = 200
     radius = radius_for_packing(n, 0.2)
@@ -178,9 +179,9 @@ def test_event_log_holds_every_contact(tmp_path):
 def test_event_log_streams_to_the_file_between_snapshots(tmp_path):
     """A run that logs much between snapshots does not hold the log in memory: each full
     buffer of the loop goes to the writer, which writes it once it holds buffer_bytes."""
-    from sim.engine import Engine
-    from sim.h5md import RunWriter
-    from sim.initial import fixed_speed, radius_for_packing, random_sequential
+    from sim.engine.core import Engine
+    from sim.pipeline.initial import fixed_speed, radius_for_packing, random_sequential
+    from sim.storage.h5md import RunWriter
 
     n = 300
     radius = radius_for_packing(n, 0.2)

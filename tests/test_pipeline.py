@@ -12,11 +12,11 @@ import pytest
 import yaml
 from hydra import compose, initialize_config_dir
 
-from sim import runner
-from sim.analysis import open_run, open_sweep
-from sim.cli import CONF_DIR
-from sim.config import ConfigError, register
-from sim.inspect import RunFileError, summary
+from sim.analysis.datasets import open_run, open_sweep
+from sim.pipeline import runner
+from sim.pipeline.cli import CONF_DIR
+from sim.pipeline.config import ConfigError, register
+from sim.storage.inspect import RunFileError, summary
 
 register()
 SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
@@ -218,7 +218,7 @@ def test_inspect_into_a_pipe_its_reader_closed_is_quiet(form, tmp_path):
     """``sim-inspect run.h5 | head -1``: the reader gone, the rest is dropped without a
     traceback. The read end is closed before the command has imported what it needs."""
     path = runner.run(compose_scene("gas", "stop.collisions=500"), tmp_path)
-    with subprocess.Popen([sys.executable, "-m", "sim.inspect", str(path), *form],
+    with subprocess.Popen([sys.executable, "-m", "sim.storage.inspect", str(path), *form],
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
         process.stdout.close()
         err = process.stderr.read()
@@ -266,16 +266,17 @@ def test_open_run_is_lazy_and_labelled(tmp_path):
 
 
 def test_a_failing_job_is_reported_and_the_others_finish(tmp_path, monkeypatch):
-    import sim.scenes
+    import sim.pipeline.scenes
 
     def crater_that_fails_for_big_projectiles(cfg):
         if cfg.projectile.radius > 0.015:
             raise RuntimeError("this projectile breaks the scene")
         return original(cfg)
 
-    original = sim.scenes.BUILDERS["crater"]
-    monkeypatch.setitem(sim.scenes.BUILDERS, "crater", crater_that_fails_for_big_projectiles)
-    from sim import cli as entry
+    original = sim.pipeline.scenes.BUILDERS["crater"]
+    monkeypatch.setitem(sim.pipeline.scenes.BUILDERS, "crater",
+                        crater_that_fails_for_big_projectiles)
+    from sim.pipeline import cli as entry
 
     monkeypatch.setattr(sys, "argv", [
         "sim", "scenario=crater", "projectile.radius=0.01,0.02", "bed.n=300",
@@ -374,7 +375,7 @@ def test_a_sweep_runs_through_submitit(tmp_path):
 def test_the_cluster_launcher_config_composes_to_slurm():
     from hydra import compose, initialize_config_dir
 
-    from sim.cli import CONF_DIR
+    from sim.pipeline.cli import CONF_DIR
 
     with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
         cfg = compose("config", overrides=["hydra/launcher=cluster"], return_hydra_config=True)

@@ -1,5 +1,5 @@
 """Damaged run files: every dataset carries a fletcher32 checksum, so bytes flipped on the
-disk are found. ``sim.inspect`` names the damaged snapshots and exits 1, ``open_run`` reads
+disk are found. ``sim.storage.inspect`` names the damaged snapshots and exits 1, ``open_run`` reads
 the intact frames and gives NaN for the damaged ones, resume falls back to the older
 checkpoint; a file written without checksums still opens, and a file a run is still writing
 is named as such."""
@@ -13,12 +13,12 @@ import h5py
 import numpy as np
 import pytest
 
-from sim import runner
-from sim.analysis import open_run
-from sim.config import ConfigError
+from sim.analysis.datasets import open_run
 from sim.figures.runs import compose_config
-from sim.h5md import read_checkpoint
-from sim.inspect import RunFileError, main, summary
+from sim.pipeline import runner
+from sim.pipeline.config import ConfigError
+from sim.storage.h5md import read_checkpoint
+from sim.storage.inspect import RunFileError, main, summary
 
 #: 300 disks, 17 snapshots, checkpoints at the first snapshot (slot a) and the last (slot b)
 RUN = ["disks.n=300", "stop.collisions=4000", "output.every_collisions=250",

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from sim.theory import (
+from sim.analysis.theory import (
     garzo_dufty_cooling_rates,
     garzo_dufty_temperature_ratio,
     maxwell_speed_cdf,

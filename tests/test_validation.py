@@ -1,9 +1,9 @@
-"""Validation against theory (sim.validation): every study is a slow test, and its rows go to
+"""Validation against theory (sim.checks.validation): every study is a slow test, and its rows go to
 the table that ``make validate`` writes to outputs/validation/table.md."""
 
 import pytest
 
-from sim.validation import STUDIES
+from sim.checks.validation import STUDIES
 
 
 @pytest.mark.slow

@@ -8,9 +8,9 @@ import pytest
 from scipy import stats
 
 from conftest import assert_no_overlap
-from sim.engine import Boundary, ClosedBoxError, Engine, InelasticCollapseError
-from sim.initial import fixed_speed, radius_for_packing, random_sequential
-from sim.walls import wall_state
+from sim.effects.walls import wall_state
+from sim.engine.core import Boundary, ClosedBoxError, Engine, InelasticCollapseError
+from sim.pipeline.initial import fixed_speed, radius_for_packing, random_sequential
 
 ALL_THERMAL = {name: {"temperature": 2.0} for name in ("left", "right", "bottom", "top")}
 
@@ -49,7 +49,8 @@ def test_driven_inelastic_gas_reaches_a_steady_state_where_input_balances_dissip
     assert put_in / dissipated == pytest.approx(1.0, abs=0.01)
     assert abs(engine.kinetic_energy() - energy) < 0.01 * dissipated
     balance = engine.initial_energy + engine.wall_work - engine.dissipated_energy
-    # round-off of sums of 5e5 terms, against the largest energy summed (as sim.inspect does)
+    # round-off of sums of 5e5 terms, against the largest energy summed (as sim.storage.inspect
+    # does)
     scale = max(engine.kinetic_energy(), abs(engine.wall_work), engine.dissipated_energy)
     assert abs(engine.kinetic_energy() - balance) < 1e-12 * scale
     assert_no_overlap(engine)

@@ -34,12 +34,19 @@ from matplotlib import pyplot as plt
 from matplotlib.ticker import NullFormatter
 from scipy import stats
 
-from sim.analysis import open_run
-from sim.crater import CraterGeometry
-from sim.engine import Boundary, Engine, InelasticCollapseError
+from sim.analysis.crater import CraterGeometry
+from sim.analysis.datasets import open_run
+from sim.checks.validation import (
+    block_means,
+    enskog_collision_frequency,
+    equilibrated_gas,
+    kolafa_rottner_z,
+    virial_blocks,
+)
+from sim.engine.core import Boundary, Engine, InelasticCollapseError
 from sim.figures.crater_runs import crater_overrides
 from sim.figures.runs import compose_config, ensure_run
-from sim.initial import (
+from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
@@ -47,14 +54,7 @@ from sim.initial import (
     random_sequential,
     remove_drift,
 )
-from sim.runner import run
-from sim.validation import (
-    block_means,
-    enskog_collision_frequency,
-    equilibrated_gas,
-    kolafa_rottner_z,
-    virial_blocks,
-)
+from sim.pipeline.runner import run
 
 
 def knob(name, setting, unit, reference, **variables):

@@ -1,4 +1,4 @@
-"""``python -m sim`` and the ``sim`` command: the command line of :mod:`sim.cli`, imported
+"""``python -m sim`` and the ``sim`` command: the command line of :mod:`sim.pipeline.cli`, imported
 inside a guard, so that Ctrl-C or SIGTERM while numba and Hydra load ends with one line."""
 
 import os  # os and sys are loaded with the interpreter: importing them costs nothing
@@ -37,7 +37,7 @@ def main():
         import signal
 
         signal.signal(signal.SIGTERM, _stop)
-        from sim.cli import main as command_line
+        from sim.pipeline.cli import main as command_line
     except BaseException as error:
         if not caused_by_a_signal(error):
             raise

@@ -9,7 +9,7 @@ liquid, and the cavity the projectile opens closes again over it (right panel: t
 area under the surface against time). The crater that scales is the transient one, the
 largest cavity, as for impacts into water. Measure: the bed's surface is read from the
 settled bed before impact (the 97th percentile of the bed disks' tops), the grid is
-calibrated on the settled bed under that surface (:func:`sim.crater.calibrated_spacing`),
+calibrated on the settled bed under that surface (:func:`sim.analysis.crater.calibrated_spacing`),
 the cavity is the area under the surface that no disk (projectile included) overlaps, less
 that area before impact, and its largest value over the snapshots is the crater. The impact
 energy is the projectile's kinetic energy when it reaches the surface,
@@ -26,8 +26,8 @@ import yaml
 from matplotlib.ticker import NullFormatter
 from scipy import stats
 
-from sim.analysis import open_sweep
-from sim.crater import calibrated_spacing, crater_area
+from sim.analysis.crater import calibrated_spacing, crater_area
+from sim.analysis.datasets import open_sweep
 from sim.figures.crater_runs import preparation_of, require_stop
 from sim.figures.style import figure, save
 

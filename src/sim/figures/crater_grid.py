@@ -1,8 +1,8 @@
 """Figure 8: the crater measure of the seed study (its Figures 1 and 2). A projectile of
 radius 0.05 falls at v = (0, −10) from (0.5, 0.75) into 4000 bed disks of radius 0.0045,
 ξ = 0.5, until 10 % of the kinetic energy is left. A grid of spacing Δx covers the bed; a cell
-is occupied when a bed disk overlaps it (exact disk–square test, sim.crater); the crater area
-is the number of empty cells times Δx².
+is occupied when a bed disk overlaps it (exact disk–square test, sim.analysis.crater); the crater
+area is the number of empty cells times Δx².
 
 Δx is the finest spacing at which the untouched bed shows no empty cell (the study chose it
 by eye). Left: occupied cells yellow, empty purple (the study's colours); right: the disks,
@@ -12,8 +12,8 @@ start (gaps between resting disks) and at the end.
 
 import numpy as np
 
-from sim.analysis import open_run
-from sim.crater import CraterGeometry, crater_area
+from sim.analysis.crater import CraterGeometry, crater_area
+from sim.analysis.datasets import open_run
 from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import draw_disks, figure, save
 

@@ -1,8 +1,8 @@
 """Figure 9: crater area against projectile radius R (the seed study's Figure 11): radii from
 0.01 to 0.10, mass ∝ R² (the bed's areal density), three beds per radius (each seed melts
 its own bed), one Hydra multirun read with open_sweep. Each run stops at 10 % of its kinetic
-energy, as in the study, and is measured on the grid of figure 8 (sim.crater), Δx calibrated
-on its own untouched bed.
+energy, as in the study, and is measured on the grid of figure 8 (sim.analysis.crater), Δx
+calibrated on its own untouched bed.
 
 Floor-limited runs: a projectile whose lowest point comes within ``FLOOR_GAP`` bed-disk
 diameters of the floor before the stop (seen at the snapshots, every 20 000 collisions, in
@@ -26,8 +26,8 @@ of floor-limited beds, the local exponent to the next radius, and the fit.
 import numpy as np
 from scipy import stats
 
-from sim.analysis import at_last_snapshot, open_sweep
-from sim.crater import CraterGeometry
+from sim.analysis.crater import CraterGeometry
+from sim.analysis.datasets import at_last_snapshot, open_sweep
 from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import figure, save
 

@@ -4,7 +4,7 @@ round-off)."""
 
 import numpy as np
 
-from sim.analysis import open_run
+from sim.analysis.datasets import open_run
 from sim.figures.gas_runs import gas_overrides
 from sim.figures.style import draw_disks, figure, save
 

@@ -11,7 +11,7 @@ of the last snapshot's N speeds (samples within one snapshot are nearly independ
 import numpy as np
 from scipy import stats
 
-from sim.analysis import open_run
+from sim.analysis.datasets import open_run
 from sim.figures.gas_runs import gas_overrides
 from sim.figures.style import figure, save
 

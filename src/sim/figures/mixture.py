@@ -5,10 +5,10 @@ the Kolmogorov–Smirnov p-value of each species' speeds in the last snapshot.""
 import numpy as np
 from scipy import stats
 
-from sim.analysis import open_run
+from sim.analysis.datasets import open_run
+from sim.analysis.theory import maxwell_speed_cdf, maxwell_speed_pdf
 from sim.figures.maxwell_boltzmann import equilibration_index
 from sim.figures.style import figure, save
-from sim.theory import maxwell_speed_cdf, maxwell_speed_pdf
 
 NAME = "fig06_mixture"
 

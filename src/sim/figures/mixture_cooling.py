@@ -1,6 +1,6 @@
 """Figure 7: the species temperatures of a cooling mixture of masses 1 and 4 (equal sizes,
 equimolar, ξ = 1, 0.9 and 0.8) settle to the homogeneous cooling state, whose ratio T₂/T₁
-Garzó & Dufty, Phys. Rev. E 60, 5706 (1999) predict (sim.theory).
+Garzó & Dufty, Phys. Rev. E 60, 5706 (1999) predict (sim.analysis.theory).
 
 Each run starts equilibrated: both species Maxwellian at one temperature, zero total
 momentum, random positions in a dilute periodic gas. The box is kept below the length at
@@ -21,9 +21,9 @@ to the mixture; the margin of 31 % covers that.
 
 import numpy as np
 
-from sim.analysis import open_sweep
+from sim.analysis.datasets import open_sweep
+from sim.analysis.theory import garzo_dufty_temperature_ratio
 from sim.figures.style import figure, save
-from sim.theory import garzo_dufty_temperature_ratio
 
 NAME = "fig07_mixture_cooling"
 RESTITUTION = (1.0, 0.9, 0.8)

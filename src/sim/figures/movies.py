@@ -1,5 +1,6 @@
-"""Movies (beyond the study), MP4s drawn by :mod:`sim.movie` beside the figures: the two-disk
-scene, the crater impact coloured by speed, and the cooling gas with its largest cluster red.
+"""Movies (beyond the study), MP4s drawn by :mod:`sim.figures.movie` beside the figures: the
+two-disk scene, the crater impact coloured by speed, and the cooling gas with its largest cluster
+red.
 
 Each run writes a snapshot at the time of every frame (``output.every_time``), so that no frame
 is drawn in free flight across contacts. Two disks: frames 0.0125 apart, 60 per second, in
@@ -11,7 +12,7 @@ clusters to grow (quick: 1000 disks until t = 40, a box too small for clusters t
 """
 
 from sim.figures.crater_runs import crater_overrides
-from sim.movie import make_movie
+from sim.figures.movie import make_movie
 
 NAME = "movies"
 

@@ -1,8 +1,8 @@
 """Runs and sweeps for the figure stages, each made once per resolved config.
 
 A run lives in ``<root>/<label>-<hash>/run.h5``, the hash taken over its resolved config and
-how its scene is prepared (:func:`sim.scenes.preparation`: a placement that changes under an
-unchanged config, such as ``auto`` becoming a melt, is a new run), so a changed config makes
+how its scene is prepared (:func:`sim.pipeline.scenes.preparation`: a placement that changes under
+an unchanged config, such as ``auto`` becoming a melt, is a new run), so a changed config makes
 a new run and an unchanged one is reused if it finished. Sweeps run as one
 Hydra multirun (``python -m sim … -m``) into ``<root>/<label>-<hash>/``.
 """
@@ -16,10 +16,10 @@ from hydra import compose, initialize_config_dir
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import OmegaConf
 
-from sim.cli import CONF_DIR
-from sim.config import register
-from sim.runner import run
-from sim.scenes import preparation
+from sim.pipeline.cli import CONF_DIR
+from sim.pipeline.config import register
+from sim.pipeline.runner import run
+from sim.pipeline.scenes import preparation
 
 register()
 
@@ -40,7 +40,7 @@ def _digest(text):
 
 def ensure_run(label, overrides, root):
     """The run file of ``overrides`` under ``root``, simulated only if not there yet (a run
-    cut short there is resumed, :func:`sim.runner.run`)."""
+    cut short there is resumed, :func:`sim.pipeline.runner.run`)."""
     cfg = compose_config([*overrides, "output.progress=false"])
     folder = Path(root) / f"{label}-{_digest(_identity(cfg))}"
     folder.mkdir(parents=True, exist_ok=True)

@@ -8,7 +8,7 @@ tan θ = sin χ / (m₁/m₂ + cos χ); physics.md, "Two-body collisions").
 
 import numpy as np
 
-from sim.analysis import at_last_snapshot, open_sweep
+from sim.analysis.datasets import at_last_snapshot, open_sweep
 from sim.figures.style import figure, save
 
 NAME = "fig03_scattering"

@@ -8,7 +8,7 @@ time: the round-off the path has gathered (zero drawn at 1e-17).
 
 import numpy as np
 
-from sim.analysis import open_run
+from sim.analysis.datasets import open_run
 from sim.figures.style import figure, save
 
 NAME = "fig01_single_disk"

@@ -10,7 +10,7 @@ rate per collision and compares that estimate with the count it measures.
 
 import numpy as np
 
-from sim.analysis import open_run
+from sim.analysis.datasets import open_run
 from sim.figures.style import figure, save
 
 NAME = "fig02_two_disks"

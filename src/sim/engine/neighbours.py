@@ -1,0 +1,431 @@
+"""Neighbour shells, their lists, and the cell grid used to build them.
+
+Design after Smallenburg, Eur. Phys. J. E 45, 22 (2022): disk i owns a shell, the circle of
+radius ``delta[i]`` around its centre c_i (set when the list was last built). Until its
+shell-exit event, disk i stays inside the shell, so i and j can only touch while
+``|c_i - c_j| < R_i + R_j + δ_i + δ_j``. The neighbour lists hold exactly those pairs and are
+kept symmetric: when i rebuilds, it leaves the lists of the neighbours it loses and joins the
+lists of the ones it gains.
+
+A new shell is centred a little ahead of its disk along its velocity (:func:`shell_centre`),
+so that in a dilute gas a disk flies further before it leaves. The grid files disks by shell
+centre, so a disk changes cell only when it rebuilds. Cells are sized for the ordinary
+("small") disks. The few disks much larger than the rest ("big", e.g. a crater projectile)
+are not filed in cells: every small disk checks them directly, and a big disk scans as many
+cells as its reach needs. So one projectile never forces large cells on everyone.
+
+Arrays (n disks):
+  disks float64[n, DISK_COLUMNS] — the disk table of :mod:`sim.engine.kinematics`, whose columns
+  CX, CY hold the shell centre; delta float64[n], or one float when every shell has the same
+  radius (:func:`sim.engine.parameters.per_disk`);
+  nb_start int32[n], nb_cap int32[n], nb_count int32[n], nb int32[sum(nb_cap)] — list of disk i
+  is ``nb[nb_start[i] : nb_start[i] + nb_count[i]]``. When every list has the same capacity
+  (no big disks), the compiled code gets that capacity instead of nb_start and nb_cap
+  (:func:`list_start`, :func:`sim.engine.parameters.per_disk`): a list's start is then computed, not
+  loaded, and the neighbours of a disk are one load closer;
+  cell_head int32[ncx*ncy], cell_next int32[n], cell_prev int32[n], cell_of int32[n] (-1 big);
+  big int32[n_big];
+  geometry float64[6] = (Lx, Ly, cell width x, cell width y, largest small R + δ, lead λ of
+  :func:`shell_centre`);
+  grid int64[4] = (cells along x, cells along y, periodic x, periodic y).
+"""
+
+import math
+
+import numpy as np
+from numba import njit, types
+from numba.extending import overload
+
+from sim.engine.kinematics import (
+    CX,
+    CY,
+    RADIUS,
+    TINY_SPEED_SQUARED,
+    VX,
+    VY,
+    X,
+    Y,
+    minimum_image,
+    wrap,
+)
+from sim.engine.parameters import per_disk
+from sim.engine.prefetch import prefetch
+
+
+def list_start(nb_start, i):
+    """Where the neighbour list of disk i starts in ``nb``: ``nb_start[i]``, or ``i * nb_start``
+    when ``nb_start`` is the capacity shared by every list."""
+    return nb_start[i] if isinstance(nb_start, np.ndarray) else i * nb_start
+
+
+@overload(list_start, inline="always")
+def _list_start(nb_start, i):
+    if isinstance(nb_start, types.Array):
+        return lambda nb_start, i: nb_start[i]
+    return lambda nb_start, i: i * nb_start
+
+
+#: Relative slack on the shell-overlap test, far above round-off and far below any physics.
+SHELL_SLACK = 1e-9
+
+
+@njit(cache=True, inline="always")
+def cell_index(x, y, geometry, grid):
+    """Cell holding the point (x, y); points on or beyond the box edge go to the edge cell."""
+    ix = int(x / geometry[2])
+    iy = int(y / geometry[3])
+    ix = min(max(ix, 0), grid[0] - 1)
+    iy = min(max(iy, 0), grid[1] - 1)
+    return iy * grid[0] + ix
+
+
+@njit(cache=True, inline="always")
+def _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
+    head = cell_head[c]
+    cell_next[i] = head
+    cell_prev[i] = -1
+    if head >= 0:
+        cell_prev[head] = i
+    cell_head[c] = i
+    cell_of[i] = c
+
+
+@njit(cache=True, inline="always")
+def _cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
+    c = cell_of[i]
+    nxt = cell_next[i]
+    prv = cell_prev[i]
+    if prv >= 0:
+        cell_next[prv] = nxt
+    else:
+        cell_head[c] = nxt
+    if nxt >= 0:
+        cell_prev[nxt] = prv
+
+
+@njit(cache=True, inline="always")
+def _remove_from_list(owner, disk, nb_start, nb_count, nb):
+    """Remove ``disk`` (which must be listed) from the list of ``owner``: the last entry
+    takes its place. The whole short list is scanned with a select instead of stopping at
+    the match, whose position the branch predictor cannot guess."""
+    start = list_start(nb_start, owner)
+    last = start + nb_count[owner] - 1
+    found = last
+    for k in range(start, last):
+        found = k if nb[k] == disk else found
+    nb[found] = nb[last]
+    nb_count[owner] -= 1
+
+
+@njit(cache=True, inline="always")
+def _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
+    """Whether the shell of j overlaps a shell of disk i centred at (cx, cy) (NaN: never).
+
+    The reach is summed per disk first, (R_i + δ_i) + (R_j + δ_j), and the separation only
+    changes sign with the order, so the test gives the same answer for (i, j) and (j, i) to the
+    last bit: the lists hold exactly the overlapping pairs, which the rebuild relies on.
+    """
+    dx = minimum_image(cx - disks[j, CX], geometry[0], grid[2] != 0)
+    dy = minimum_image(cy - disks[j, CY], geometry[1], grid[3] != 0)
+    reach_i = disks[i, RADIUS] + per_disk(delta, i)
+    reach_j = disks[j, RADIUS] + per_disk(delta, j)
+    reach = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
+    return dx * dx + dy * dy < reach * reach
+
+
+@njit(cache=True, inline="always")
+def _axis_span(c, k, nc, periodic):
+    """Cells c - k … c + k along an axis of nc cells: a half-open range of cell indices, which
+    run beyond 0 … nc - 1 on a periodic axis (images, see :func:`_fold`)."""
+    if periodic:
+        if 2 * k + 1 >= nc:
+            return 0, nc
+        return c - k, c + k + 1
+    return max(0, c - k), min(nc, c + k + 1)
+
+
+@njit(cache=True, inline="always")
+def _fold(a, nc):
+    """Cell index of the image a (-nc ≤ a < 2 nc) along a periodic axis of nc cells; a compare
+    and an add instead of the integer division of ``a % nc``."""
+    if a < 0:
+        return a + nc
+    if a >= nc:
+        return a - nc
+    return a
+
+
+@njit(cache=True, inline="always")
+def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb, free,
+              room, geometry, grid):
+    """One candidate j for the search of :func:`_find_new_neighbours`: written into the next
+    free slot, counted when it is new. Returns the new count, or -1 when a new neighbour does
+    not fit the list."""
+    listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
+    new = ((j != i) & (j >= first_candidate) & (not listed)
+           & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
+    if found < room:
+        nb[free + found] = j
+    elif new:
+        return -1
+    return found + new
+
+
+@njit(cache=True, inline="always")
+def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid):
+    """Hint the cache for the row of every disk filed in the cells of a scan (spans of
+    :func:`_axis_span`), before the scan reads them.
+
+    The scan walks each cell's linked list and tests every disk it meets, so without hints
+    its loads of the disks' rows wait one after another, as far as the CPU can run ahead of
+    the tests. Walking the lists first, which costs little (``cell_next`` is small and mostly
+    in cache), asks for all rows at once. Against the scan without it
+    (``benchmarks/compare_builds.py``, on a day the machine waited 210–250 ns on memory beyond
+    4 MiB): 1.18 at N = 1e5 and 1.16 at 1e6, φ = 0.5; 1.33 and 1.12 at 1e5, φ = 0.1 and 0.7;
+    1.10, 1.19 and 1.02 at 1e4, φ = 0.5, 0.1 and 0.7. On a day memory answered in 6 ns up to
+    0.5 MiB and 38 ns at 4 MiB, the scan without hints beat it while the state fits the
+    caches: 1.10, 1.03 and 1.02 at 1e4, φ = 0.1, 0.5 and 0.7; 1.13 and 1.06 at 1e3, φ = 0.1
+    and 0.5; 1.04 and 1.01 at 2e4; 1.00 and 0.99 at 3e4. Hence the hints only with the
+    look-ahead (:data:`sim.engine.core.LOOKAHEAD_MIN_DISKS`).
+    """
+    ncx = grid[0]
+    ncy = grid[1]
+    for ay in range(y_lo, y_hi):
+        row = _fold(ay, ncy) * ncx
+        for ax in range(x_lo, x_hi):
+            j = cell_head[row + _fold(ax, ncx)]
+            while j >= 0:
+                prefetch(disks, j)
+                j = cell_next[j]
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
+                         nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
+                         grid, hint_candidates):
+    """Append after the list of disk i (its count unchanged) every disk j ≥ first_candidate,
+    j ≠ i, whose shell overlaps the shell of i centred at (cx, cy) but not the one centred at
+    (cx_old, cy_old); NaN for the old centre drops that condition.
+
+    Small disks scan the 3×3 cells around (cx, cy) and the big disks; a big disk scans the cells
+    within its reach. Returns the number of disks found, or -1 when they do not fit the list.
+    Every candidate is written into the next free slot and the number advances only on a hit:
+    no branch on the test, whose outcome the branch predictor cannot guess.
+
+    ``hint_candidates``: hint the rows of all candidates first (:func:`_prefetch_candidates`).
+
+    Compiled once and called, not inlined, by :func:`rebuild_neighbours` and
+    :func:`build_all_neighbours` (both pass ``i`` and ``first_candidate`` as int64 and
+    ``hint_candidates`` as a bool from Python, never a literal, so that they share one
+    specialisation): 3.5 s less of the first compilation, and 2.8 s more for a literal.
+    """
+    ncx = grid[0]
+    ncy = grid[1]
+    c = cell_index(cx, cy, geometry, grid)
+    if cell_of[i] >= 0:
+        kx = 1
+        ky = 1
+    else:
+        reach = disks[i, RADIUS] + per_disk(delta, i) + geometry[4]
+        kx = int(math.ceil(reach / geometry[2]))
+        ky = int(math.ceil(reach / geometry[3]))
+    x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[2] != 0)
+    y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[3] != 0)
+    free = list_start(nb_start, i) + nb_count[i]
+    room = per_disk(nb_cap, i) - nb_count[i]
+    if hint_candidates:
+        _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid)
+    found = 0
+    for ay in range(y_lo, y_hi):
+        row = _fold(ay, ncy) * ncx
+        for ax in range(x_lo, x_hi):
+            j = cell_head[row + _fold(ax, ncx)]
+            while j >= 0:
+                found = _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks,
+                                  delta, nb, free, room, geometry, grid)
+                if found < 0:
+                    return -1
+                j = cell_next[j]
+    for b in range(big.shape[0]):
+        found = _consider(big[b], found, i, cx, cy, cx_old, cy_old, first_candidate, disks,
+                          delta, nb, free, room, geometry, grid)
+        if found < 0:
+            return -1
+    return found
+
+
+@njit(cache=True, inline="always")
+def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
+    """Hint the cache for a rebuild of a small disk's list near (x, y), which scans the 3×3
+    cells around it (:func:`_find_new_neighbours`). Without ``members``: the heads of those
+    cells. With ``members``: the heads are read (they should be in cache by now) and for each
+    cell the head and the disk numbered before it are hinted (after a renumbering by cell the
+    disks of a cell carry consecutive numbers, so that one is mostly a cell-mate)."""
+    ncx = grid[0]
+    ncy = grid[1]
+    c = cell_index(x, y, geometry, grid)
+    x_lo, x_hi = _axis_span(c % ncx, 1, ncx, grid[2] != 0)
+    y_lo, y_hi = _axis_span(c // ncx, 1, ncy, grid[3] != 0)
+    for ay in range(y_lo, y_hi):
+        row = _fold(ay, ncy) * ncx
+        if not members:
+            prefetch(cell_head, row + _fold(x_lo, ncx))
+            prefetch(cell_head, row + _fold(x_hi - 1, ncx))
+            continue
+        for ax in range(x_lo, x_hi):
+            j = cell_head[row + _fold(ax, ncx)]
+            if j >= 0:
+                prefetch(disks, j)
+                prefetch(cell_next, j)
+                if j > 0:
+                    prefetch(disks, j - 1)
+
+
+@njit(cache=True, inline="always")
+def shell_centre(i, disks, delta, geometry, grid):
+    """Centre (cx, cy) of a new shell for disk i: ahead of the disk along its velocity by
+    λ δ_i, λ = ``geometry[5]`` < 1, wrapped into a periodic box.
+
+    Any centre within δ_i of the disk is valid; one ahead of a disk in free flight lets it
+    cross (1 + λ) δ_i instead of δ_i before it leaves the shell, so a dilute gas, whose disks
+    fly further than δ between collisions, rebuilds fewer lists. A disk at rest, or too slow
+    ever to reach its shell (``TINY_SPEED_SQUARED``), is centred on itself.
+    """
+    vx = disks[i, VX]
+    vy = disks[i, VY]
+    speed_squared = vx * vx + vy * vy
+    lead = (geometry[5] * per_disk(delta, i) / math.sqrt(speed_squared)
+            if speed_squared > TINY_SPEED_SQUARED else 0.0)
+    return (wrap(disks[i, X] + lead * vx, geometry[0], grid[2] != 0),
+            wrap(disks[i, Y] + lead * vy, geometry[1], grid[3] != 0))
+
+
+@njit(cache=True, inline="always")
+def _full_list(first, found, nb_start, nb_cap, nb_count, nb):
+    """The first disk among ``nb[first : first + found]`` whose list is full, or -1."""
+    for k in range(first, first + found):
+        j = nb[k]
+        if nb_count[j] >= per_disk(nb_cap, j):
+            return j
+    return -1
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_head, cell_next,
+                       cell_prev, cell_of, big, geometry, grid, hint_candidates):
+    """New shell for disk i centred on its current position, and its new list.
+
+    Only the differences are written. The lists hold exactly the pairs of overlapping shells,
+    so a disk near the new centre is new to the list when its shell overlaps the new shell but
+    not the old one; an old neighbour is dropped when its shell misses the new one. A shell
+    moves by δ between rebuilds, so most neighbours stay and their lists are not touched.
+
+    First the new neighbours are found and every list they join is checked for room; only then
+    are lists changed and the shell moved. On overflow (returned disk id ≥ 0) nothing has
+    changed, and calling again after enlarging the lists does the rebuild.
+    ``hint_candidates``: see :func:`_find_new_neighbours`.
+    """
+    cx, cy = shell_centre(i, disks, delta, geometry, grid)
+    start = list_start(nb_start, i)
+    old = nb_count[i]
+    found = _find_new_neighbours(np.int64(i), cx, cy, disks[i, CX], disks[i, CY], np.int64(0),
+                                 disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
+                                 cell_next, cell_of, big, geometry, grid, hint_candidates)
+    if found < 0:
+        return i
+    full = _full_list(start + old, found, nb_start, nb_cap, nb_count, nb)
+    if full >= 0:
+        return full
+    kept = start
+    for k in range(start, start + old):
+        j = nb[k]
+        if _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
+            nb[kept] = j
+            kept += 1
+        else:
+            _remove_from_list(j, i, nb_start, nb_count, nb)
+    for k in range(start + old, start + old + found):
+        j = nb[k]
+        nb[kept] = j
+        kept += 1
+        nb[list_start(nb_start, j) + nb_count[j]] = i
+        nb_count[j] += 1
+    nb_count[i] = kept - start
+    disks[i, CX] = cx
+    disks[i, CY] = cy
+    if cell_of[i] >= 0:
+        c = cell_index(cx, cy, geometry, grid)
+        if c != cell_of[i]:
+            _cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
+            _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+    return -1
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, cell_head,
+                         cell_next, cell_prev, cell_of, big, geometry, grid, hint_candidates):
+    """Centre every shell on its disk, file the small disks in cells and link all pairs.
+    Returns the disk whose list overflowed, or -1. ``hint_candidates``: see
+    :func:`_find_new_neighbours`."""
+    n = disks.shape[0]
+    cell_head[:] = -1
+    nb_count[:] = 0
+    for i in range(n):
+        disks[i, CX] = disks[i, X]
+        disks[i, CY] = disks[i, Y]
+        if is_big[i]:
+            cell_of[i] = -1
+        else:
+            c = cell_index(disks[i, CX], disks[i, CY], geometry, grid)
+            _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+    for i in range(n):
+        first = list_start(nb_start, i) + nb_count[i]
+        found = _find_new_neighbours(np.int64(i), disks[i, CX], disks[i, CY], np.nan, np.nan,
+                                     np.int64(i + 1), disks, delta, nb_start, nb_cap, nb_count,
+                                     nb, cell_head, cell_next, cell_of, big, geometry, grid,
+                                     hint_candidates)
+        if found < 0:
+            return i
+        full = _full_list(first, found, nb_start, nb_cap, nb_count, nb)
+        if full >= 0:
+            return full
+        for k in range(first, first + found):
+            j = nb[k]
+            nb[list_start(nb_start, j) + nb_count[j]] = i
+            nb_count[j] += 1
+        nb_count[i] += found
+    return -1
+
+
+@njit(cache=True)
+def copy_lists(order, new_id, nb_start, nb_count, nb, new_start, new_nb):
+    """Write into ``new_nb`` at ``new_start[k]`` the list of disk ``order[k]``, each entry j
+    as ``new_id[j]``: lists moved to a new layout (identity ``order`` and ``new_id``) or
+    renumbered, without temporary arrays."""
+    for k in range(order.shape[0]):
+        i = order[k]
+        for m in range(nb_count[i]):
+            new_nb[new_start[k] + m] = new_id[nb[nb_start[i] + m]]
+
+
+def list_starts(capacity):
+    """Offsets int32[n] of the lists in ``nb`` for the capacities ``capacity``: each list
+    starts where the one before it ends."""
+    ends = np.cumsum(capacity, dtype=np.int64)
+    if ends.size and ends[-1] > np.iinfo(np.int32).max:
+        raise MemoryError(f"the neighbour lists need {ends[-1]} slots, more than int32 indexes; "
+                          f"use fewer disks or a smaller neighbour shell")
+    starts = np.zeros(capacity.size, dtype=np.int32)
+    starts[1:] = ends[:-1]
+    return starts
+
+
+def grow_lists(nb_start, nb_count, nb, new_cap):
+    """Return the list starts and lists (``nb_start``, ``nb``) laid out anew for the
+    capacities ``new_cap`` int32[n], each at least the old one; contents and counts are kept.
+    A rare step, done between compiled calls."""
+    new_start = list_starts(new_cap)
+    new_nb = np.full(int(new_cap.sum(dtype=np.int64)), -1, dtype=np.int32)
+    identity = np.arange(nb_start.size)
+    copy_lists(identity, identity, nb_start, nb_count, nb, new_start, new_nb)
+    return new_start, new_nb

@@ -1,0 +1,126 @@
+"""Stop conditions that need more than a count: a scene at rest, conditions a resumed run has
+met already, and conditions a scene can never meet.
+
+A run ends at the first of its conditions that holds (``stop:`` in the config). A condition
+on disk–disk collisions in a scene whose disks can never touch, on contacts in a periodic box
+of disks that never meet, on the energy contacts dissipate where none can, or on a kinetic
+energy that never changes would never hold;
+when every condition of a scene is of that kind, :func:`check_reachable` refuses the scene
+before any work. (A scene in which nothing moves at all ends by itself: the engine then has
+no event left, stop reason ``no_events``.)
+"""
+
+import numpy as np
+
+from sim.pipeline.config import ConfigError
+
+#: Above this many disks the pairwise test of :func:`_disks_never_touch` is skipped (it is
+#: O(N²) in memory); scenes of disks that provably never meet are small hand-made ones.
+PAIRWISE_LIMIT = 2000
+
+
+def at_rest(fraction):
+    """Stop predicate of ``stop.at_rest``: the kinetic energy of every species has fallen below
+    ``fraction`` of the initial total. Hard-disk dynamics has no energy scale (a run at
+    speeds ×λ is the same run in time /λ, unless the TC model's fixed t_c intervenes), so it
+    ends runs that differ only in their speeds at the same stage."""
+    def predicate(engine):
+        return bool(np.all(engine.kinetic_energy_by_species() < fraction * engine.initial_energy))
+    return predicate
+
+
+def already_met(engine, cfg):
+    """The first stop condition of ``cfg`` that ``engine`` (restored from a checkpoint) meets
+    already, as ``(key, value, explanation)`` for :class:`ConfigError`; None if none does."""
+    s = cfg.stop
+    if s.collisions is not None and engine.collisions >= s.collisions:
+        return ("stop.collisions", s.collisions,
+                f"more than the {engine.collisions} collisions the run has made already")
+    if s.events is not None and engine.events >= s.events:
+        return ("stop.events", s.events,
+                f"more than the {engine.events} contacts the run has made already")
+    if s.time is not None and engine.time >= s.time:
+        return ("stop.time", s.time, f"later than t = {engine.time:.6g}, where the run is")
+    if s.energy_fraction is not None and \
+            engine.dissipated_energy >= engine.initial_energy * (1.0 - s.energy_fraction):
+        left = 1.0 - engine.dissipated_energy / engine.initial_energy
+        return ("stop.energy_fraction", s.energy_fraction,
+                f"below the fraction {left:.6g} of the initial energy the run has left")
+    if s.at_rest is not None and at_rest(s.at_rest)(engine):
+        return ("stop.at_rest", s.at_rest, "a fraction the run has not reached yet")
+    return None
+
+
+def _disks_never_touch(engine):
+    """Whether no two disks of ``engine`` can ever touch: no force acts between contacts
+    (no gravity, every wall still and not thermal), and every pair either moves with one
+    velocity in a periodic box, or keeps an axis fixed on which the two are further apart
+    than contact (a disk with v_x = 0 keeps its x until its first contact, also when it
+    bounces off the walls along y)."""
+    if engine.n < 2:
+        return True
+    if engine.gravity is not None or engine.wall_motion is not None \
+            or engine.wall_temperature is not None or engine.n > PAIRWISE_LIMIT:
+        return False
+    position, velocity = engine.positions(), engine.velocities()
+    one_velocity = np.all(engine.periodic) and np.all(velocity == velocity[0])
+    if np.any(np.all(velocity != 0.0, axis=1)) and not one_velocity:
+        return False  # a disk moving along no axis may meet any other: no pairs to test
+    radius = engine.radius
+    pairs = np.triu_indices(engine.n, 1)
+    sigma = radius[pairs[0]] + radius[pairs[1]]
+    never = np.zeros(sigma.size, dtype=bool)
+    if np.all(engine.periodic):
+        never |= np.all(velocity[pairs[0]] == velocity[pairs[1]], axis=1)
+    for axis in range(2):
+        fixed = velocity[:, axis] == 0.0
+        gap = np.abs(position[pairs[0], axis] - position[pairs[1], axis])
+        if engine.periodic[axis]:
+            gap = np.minimum(gap, engine.box[axis] - gap)
+        never |= fixed[pairs[0]] & fixed[pairs[1]] & (gap >= sigma)
+    return bool(np.all(never))
+
+
+def _conserves_kinetic_energy(engine):
+    """No contact loses energy, no wall gives or takes any, no field changes it."""
+    return (engine.restitution is None and engine.wall_restitution is None
+            and engine.gravity is None and engine.wall_motion is None
+            and engine.wall_temperature is None)
+
+
+def _dissipates(engine, never_touch):
+    """Whether any contact can lose energy: inelastic disks that can meet, or inelastic walls
+    in a box that has walls (the engine's energy fraction counts what contacts dissipate)."""
+    return ((engine.restitution is not None and not never_touch)
+            or (engine.wall_restitution is not None and not np.all(engine.periodic)))
+
+
+def check_reachable(cfg, engine):
+    """Refuse (:class:`ConfigError` on ``stop``) a scene none of whose stop conditions can
+    ever hold for the initial state of ``engine``; see the module docstring."""
+    s = cfg.stop
+    if s.time is not None or s.wall_seconds is not None:
+        return
+    if np.all(engine.velocities() == 0.0) and engine.gravity is None \
+            and engine.wall_motion is None:
+        return  # nothing moves: the run ends at once with no events left
+    why = {}
+    never_touch = _disks_never_touch(engine)
+    if s.collisions is not None and never_touch:
+        why["stop.collisions"] = ("one disk has no other to collide with" if engine.n == 1
+                                  else "these disks never touch one another")
+    if s.events is not None and never_touch and np.all(engine.periodic):
+        why["stop.events"] = "a periodic box has no walls and these disks never touch"
+    if s.energy_fraction is not None and s.energy_fraction < 1.0 \
+            and not _dissipates(engine, never_touch):
+        why["stop.energy_fraction"] = "no contact dissipates energy (elastic disks and walls, " \
+                                      "or inelastic disks that never meet)"
+    if s.at_rest is not None and _conserves_kinetic_energy(engine) and engine.n_species == 1:
+        why["stop.at_rest"] = "the kinetic energy never changes"
+    given = [key for key in ("collisions", "events", "energy_fraction", "at_rest")
+             if s[key] is not None]
+    if given and len(why) == len(given):
+        reasons = "; ".join(f"{key}: {text}" for key, text in why.items())
+        raise ConfigError("stop", {key: s[key] for key in given},
+                          f"a condition the scene can meet ({reasons}); add stop.time or "
+                          f"stop.wall_seconds, or change the scene")

@@ -1,0 +1,24 @@
+"""The layout: every old import path of the flat package still leads to its module, with a
+DeprecationWarning, and ``python -m`` on an old path runs the new module."""
+
+import importlib
+import subprocess
+import sys
+
+import pytest
+
+from sim.moved import MOVED
+
+
+@pytest.mark.parametrize("old", sorted(MOVED))
+def test_old_path_gives_the_module_with_a_warning(old):
+    sys.modules.pop(old, None)
+    with pytest.warns(DeprecationWarning, match=MOVED[old]):
+        module = importlib.import_module(old)
+    assert module is importlib.import_module(MOVED[old])
+
+
+def test_old_command_path_runs():
+    out = subprocess.run([sys.executable, "-m", "sim.inspect", "--help"], capture_output=True,
+                         text=True, check=True)
+    assert out.stdout.startswith("usage: sim-inspect")
