@@ -119,7 +119,7 @@ def test_a_lone_disk_squeezed_by_a_piston_is_stopped_before_the_walls_meet():
 
 def floor_gap(engine, t):
     """Gap between each disk and the floor at absolute time t."""
-    floor = wall_state(2, t, engine.geometry, engine.wall_motion)[0]
+    floor = wall_state(engine.wall_motion, 2, t, engine.geometry)[0]
     return engine.positions(t)[:, 1] - engine.radius - floor
 
 
@@ -148,7 +148,7 @@ def test_ball_on_a_vibrating_floor_meets_it_exactly_and_never_sinks_into_it():
         engine.run(events=contacts + 1)
         if engine.wall_collisions > contacts:  # a contact, not a re-prediction
             assert abs(floor_gap(engine, engine.time)[0]) <= 1e-14
-            floor_speed = wall_state(2, engine.time, engine.geometry, engine.wall_motion)[1]
+            floor_speed = wall_state(engine.wall_motion, 2, engine.time, engine.geometry)[1]
             assert engine.velocities()[0, 1] >= floor_speed
     late = [height for t, height in heights if t > 80 * period]
     assert max(late) > 0.01  # still flying higher than the floor's amplitude

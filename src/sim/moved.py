@@ -12,7 +12,7 @@ MOVED = {
     "sim.kinematics": "sim.engine.kinematics", "sim.flight": "sim.engine.flight",
     "sim.collision_rules": "sim.engine.contact", "sim.parameters": "sim.engine.parameters",
     "sim.prefetch": "sim.engine.prefetch", "sim.gravity": "sim.effects.gravity",
-    "sim.walls": "sim.effects.walls", "sim.recorders": "sim.effects.recorders",
+    "sim.walls": "sim.effects.walls", "sim.recorders": "sim.effects.event_log",
     "sim.config": "sim.pipeline.config", "sim.scenes": "sim.pipeline.scenes",
     "sim.initial": "sim.pipeline.initial", "sim.runner": "sim.pipeline.runner",
     "sim.cli": "sim.pipeline.cli", "sim.callbacks": "sim.pipeline.callbacks",

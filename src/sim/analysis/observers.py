@@ -9,7 +9,7 @@ giving the value at a snapshot at absolute time t from the engine and the positi
 velocities float64[n, 2] at that time. Observers run in Python between compiled chunks, never
 per event; a scene that names none pays nothing. Two need the compiled loop's help, which the
 engine gives only when asked: unwrapped positions (``unwrap``, :mod:`sim.engine.flight`) and the
-collision virial tensor (``pressure_tensor``, :mod:`sim.effects.recorders`).
+collision virial tensor (``pressure_tensor``, :mod:`sim.effects.pressure_tensor`).
 """
 
 import numpy as np
@@ -212,8 +212,8 @@ class KineticTensor:
 
 
 class VirialTensor(KineticTensor):
-    """Σ r_a Δp_b over all disk contacts so far (:mod:`sim.effects.recorders`): its growth over an
-    interval, divided by the interval, is the collisional part of the pressure tensor times
+    """Σ r_a Δp_b over all disk contacts so far (:mod:`sim.effects.pressure_tensor`): its growth
+    over an interval, divided by the interval, is the collisional part of the pressure tensor times
     the area (:func:`sim.analysis.datasets.pressure_tensor`)."""
 
     name = "collision_virial_tensor"

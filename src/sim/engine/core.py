@@ -19,10 +19,16 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from sim.effects import Effects
+from sim.effects.event_log import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
 from sim.effects.gravity import gravity_vector, potential_energy
-from sim.effects.recorders import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
-from sim.effects.walls import NAMES, wall_motion, wall_state, wall_temperature
+from sim.effects.restitution import CollapseWatch, restitution_matrix, wall_restitution_value
+from sim.effects.tc import tc_time
+from sim.effects.thermal_walls import wall_temperature
+from sim.effects.walls import wall_motion, wall_state
 from sim.engine import loop
+from sim.engine.box import WALL_NAMES
+from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
 from sim.engine.kinematics import DISK_COLUMNS, RADIUS, T_OWN, VX, VY, X, Y, minimum_image
 from sim.engine.neighbours import build_all_neighbours, grow_lists, list_starts
 from sim.engine.parameters import common_value
@@ -102,7 +108,7 @@ class InelasticCollapseError(PhysicsBreakdown):
 
 
 #: wall numbers of :mod:`sim.effects.walls` by name
-WALLS = {name: wall for wall, name in enumerate(NAMES)}
+WALLS = {name: wall for wall, name in enumerate(WALL_NAMES)}
 
 #: The keys a wall's entry in ``walls`` may have.
 WALL_KEYS = ("temperature", "speed", "amplitude", "frequency")
@@ -475,11 +481,11 @@ def _check_scales(box, radius, mass, velocity, extent, gravity, motion, temperat
               math.sqrt(float(np.hypot(*gravity)) * float(np.max(box))))
     for wall in range(4):
         if motion is not None and np.any(motion[wall, :2]):
-            check(f"the speed |U| + A ω of the {NAMES[wall]} wall",
+            check(f"the speed |U| + A ω of the {WALL_NAMES[wall]} wall",
                   abs(motion[wall, 0]) + motion[wall, 1] * motion[wall, 2])
         if temperature is not None and not math.isnan(temperature[wall]):
             for m in (mass.min(), mass.max()):
-                check(f"√(T_w / m) of the {NAMES[wall]} wall for mass {m:g}",
+                check(f"√(T_w / m) of the {WALL_NAMES[wall]} wall for mass {m:g}",
                       math.sqrt(temperature[wall] / m))
     i = int(np.argmin(radius))
     if radius[i] < RESOLUTION_LIMIT * extent:
@@ -498,22 +504,6 @@ def _seed(seed):
     if value is None or not 0 <= value <= np.iinfo(np.int64).max:
         raise ValueError(f"seed must be an integer in [0, 2**63 - 1], got {seed!r}")
     return value
-
-
-def _restitution_matrix(restitution, n_species):
-    """None for elastic contacts (the effect is dropped), else float64[s, s]."""
-    if restitution is None:
-        return None
-    xi = np.broadcast_to(np.asarray(restitution, dtype=np.float64), (n_species, n_species))
-    if not np.all((xi >= 0.0) & (xi <= 1.0)):
-        raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
-    if not np.array_equal(xi, xi.T):
-        raise ValueError(f"restitution matrix must be symmetric, got {xi.tolist()}")
-    if np.all(xi == 1.0):
-        return None
-    # always a fresh writable copy: numba types read-only arrays apart, so a view passed on
-    # for some inputs would compile the event loop a second time for the same effects
-    return np.array(xi)
 
 
 class Engine:
@@ -582,15 +572,10 @@ class Engine:
         position = np.where(periodic, position % box, position)
         _check_inside(given, position, radius, box, periodic)
 
-        self.restitution = _restitution_matrix(restitution, self.n_species)
-        if wall_restitution is not None and not 0.0 <= wall_restitution <= 1.0:
-            raise ValueError(f"wall_restitution must lie in [0, 1], got {wall_restitution}")
-        self.wall_restitution = (None if wall_restitution is None or wall_restitution == 1.0
-                                 else float(wall_restitution))
-        if tc is not None and not 0.0 <= tc < math.inf:
-            raise ValueError(f"tc (the TC-model time) must be finite and ≥ 0, or None; got {tc}")
+        self.restitution = restitution_matrix(restitution, self.n_species)
+        self.wall_restitution = wall_restitution_value(wall_restitution)
         dissipative = self.restitution is not None or self.wall_restitution is not None
-        self.tc = float(tc) if (tc and dissipative) else None
+        self.tc = tc_time(tc, dissipative)
         self.gravity = gravity_vector(gravity)
         if self.gravity is not None and np.any(self.gravity[periodic] != 0.0):
             raise ValueError(f"gravity {self.gravity.tolist()} has a component along a periodic "
@@ -763,6 +748,18 @@ class Engine:
             cell_head=np.full(n_cells, -1, dtype=np.int32),
             images=np.zeros((n, 2), dtype=np.int32) if unwrap else None)
 
+    def _effects(self):
+        """The scene's effects as the compiled loop takes them (:class:`sim.effects.Effects`)."""
+        dissipative = self.restitution is not None or self.wall_restitution is not None
+        return Effects(
+            restitution=self.restitution, wall_restitution=self.wall_restitution,
+            collapse=(CollapseWatch(self.collapse_interval, self.collapse_streak)
+                      if dissipative else None),
+            tc=self.tc, gravity=self.gravity, wall_motion=self.wall_motion,
+            wall_temperature=self.wall_temperature, seed=self.seed, images=self.disks.images,
+            virial_tensor=self.virial_tensor,
+            event_log=None if self.event_log is None else (self.event_log, self.log_fill))
+
     def _per_disk_parameters(self):
         """Shell radius, mass and species as the compiled loop takes them: the number every
         disk shares, else the array (:func:`sim.engine.parameters.per_disk`)."""
@@ -804,18 +801,17 @@ class Engine:
             d = self.disks
             reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
             status, disk = loop.run_events(
-                d.table, *self._per_disk_parameters(), d.coll_count, d.contacts, d.t_last,
-                d.streak, d.event_time, d.event_partner, d.event_count, *d.queue,
-                *self._list_layout(), d.nb_count, d.nb,
-                d.cell_head, d.cell_next, d.cell_prev, d.cell_of, d.big, self.geometry,
-                self.grid, self.restitution, self.wall_restitution, self.tc, self.gravity,
-                self.wall_motion, self.wall_temperature, self.seed, d.images,
-                self.virial_tensor, self.event_log, self.log_fill, self.counters,
-                self.accumulators, self.pair_collisions, self.wall_impulse,
-                min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
-                dissipation_limit,
-                self.collapse_interval, self.collapse_streak, self.stall_dt, self.stall_watch,
-                self.rebase_every, self.lookahead)
+                Disks(d.table, *self._per_disk_parameters(), d.coll_count, d.contacts,
+                      d.t_last, d.streak),
+                Schedule(d.event_time, d.event_partner, d.event_count, *d.queue),
+                Neighbours(*self._list_layout(), d.nb_count, d.nb, d.cell_head, d.cell_next,
+                           d.cell_prev, d.cell_of, d.big),
+                Box(self.geometry, self.grid),
+                self._effects(),
+                Tallies(self.counters, self.accumulators, self.pair_collisions,
+                        self.wall_impulse, self.stall_watch),
+                Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
+                       dissipation_limit, self.stall_dt, self.rebase_every, self.lookahead))
             self.drain_event_log()
             if status == loop.STATUS_LOG_FULL:
                 continue
@@ -929,11 +925,11 @@ class Engine:
 
     @property
     def collisions(self):
-        return int(self.counters[loop.DISK_COLLISIONS])
+        return int(self.counters[loop.COLLISIONS])
 
     @property
     def wall_collisions(self):
-        return int(self.counters[loop.WALL_COLLISIONS])
+        return int(self.counters[loop.WALL_CONTACTS])
 
     @property
     def events(self):
@@ -1032,7 +1028,7 @@ class Engine:
     def wall_positions(self, t=None):
         """Positions float64[4] of the walls (left, right, bottom, top) at absolute time t."""
         t_abs = self.time if t is None else float(t)
-        return np.array([wall_state(w, t_abs, self.geometry, self.wall_motion)[0]
+        return np.array([wall_state(self.wall_motion, w, t_abs, self.geometry)[0]
                          for w in range(4)])
 
     def collisions_by_disk(self):
@@ -1090,7 +1086,7 @@ class Engine:
 
     def take_event_log(self):
         """The contacts logged since the last call: float64[k, 6], columns as in
-        :mod:`sim.effects.recorders` (disks in the user's numbering)."""
+        :mod:`sim.effects.event_log` (disks in the user's numbering)."""
         self.drain_event_log()
         rows = (np.concatenate(self._logged) if self._logged
                 else np.zeros((0, LOG_COLUMNS)))

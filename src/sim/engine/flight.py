@@ -1,45 +1,39 @@
-"""Free flight between events: straight lines, or parabolas under gravity.
+"""Free flight between events.
 
 A disk stored at position r and velocity v at its own time t_d (lazy update, columns of the
 disk table in :mod:`sim.engine.kinematics`) is at time t, with dt = t − t_d, at
+r + v dt: a straight line, or under gravity the parabola of :mod:`sim.effects.gravity`
+(r + v dt + g dt²/2, v + g dt). Every disk falls alike, so the relative motion of two disks
+stays a straight line and pair contacts keep their exact quadratic roots.
 
-    r(t) = r + v dt + g dt²/2,    v(t) = v + g dt,
-
-where g float64[2] is the uniform acceleration of :mod:`sim.effects.gravity`, or None (then g = 0
-and its terms are not compiled). Every disk falls alike, so the relative motion of two disks stays
-a straight line and pair contacts keep their exact quadratic roots.
-
-On a periodic axis a position is folded back into the box; ``images`` int32[n, 2], when given
-(None otherwise, and no code is compiled for it), counts the times each disk has been folded
-(+1 for leaving through the high side), so that r + images · L is the unwrapped position that
-mean squared displacements need.
+On a periodic axis a position is folded back into the box; the folds are counted when a scene
+observes unwrapped positions (:mod:`sim.effects.unwrap`).
 """
 
 from numba import njit
 
+from sim.effects.gravity import displacement, fall, velocity_at
+from sim.effects.unwrap import count_winding
+from sim.engine.box import PERIODIC, SIDE
 from sim.engine.kinematics import T_OWN, VX, X, wrap
 
 
 @njit(cache=True, inline="always")
-def displacement(i, axis, dt, disks, gravity):
+def flown(i, axis, dt, disks, gravity):
     """How far disk i moves along ``axis`` in the time ``dt`` after its own time."""
-    if gravity is None:
-        return disks[i, VX + axis] * dt
-    return (disks[i, VX + axis] + 0.5 * gravity[axis] * dt) * dt
+    return displacement(gravity, axis, disks[i, VX + axis], dt)
 
 
 @njit(cache=True, inline="always")
 def position_at(i, axis, dt, disks, gravity):
     """Coordinate ``axis`` of disk i, ``dt`` after its own time, not folded into the box."""
-    return disks[i, X + axis] + displacement(i, axis, dt, disks, gravity)
+    return disks[i, X + axis] + flown(i, axis, dt, disks, gravity)
 
 
 @njit(cache=True, inline="always")
-def velocity_at(i, axis, dt, disks, gravity):
+def velocity_of(i, axis, dt, disks, gravity):
     """Velocity component ``axis`` of disk i, ``dt`` after its own time."""
-    if gravity is None:
-        return disks[i, VX + axis]
-    return disks[i, VX + axis] + gravity[axis] * dt
+    return velocity_at(gravity, axis, disks[i, VX + axis], dt)
 
 
 @njit(cache=True, inline="always")
@@ -49,11 +43,8 @@ def fly(i, t, disks, geometry, grid, gravity, images):
     dt = t - disks[i, T_OWN]
     for axis in range(2):
         x = position_at(i, axis, dt, disks, gravity)
-        folded = wrap(x, geometry[axis], grid[2 + axis] != 0)
-        if images is not None:
-            if folded != x:
-                images[i, axis] += 1 if x > folded else -1
+        folded = wrap(x, geometry[SIDE + axis], grid[PERIODIC + axis] != 0)
+        count_winding(images, i, axis, x, folded)
         disks[i, X + axis] = folded
-        if gravity is not None:
-            disks[i, VX + axis] = velocity_at(i, axis, dt, disks, gravity)
+        fall(gravity, disks, i, axis, dt)
     disks[i, T_OWN] = t

@@ -9,25 +9,24 @@ Each disk owns one scheduled event, the earliest of (Smallenburg, Eur. Phys. J. 
   * at construction, its first prediction (``partner = UNPREDICTED``, at the current time):
     every disk is predicted through the loop's one inlined copy of :func:`predict`, which
     spares the compiler a second copy.
-Positions are advanced lazily: disk i is stored at ``disks[i, X:Y+1]`` at its own time
-``disks[i, T_OWN]`` (disk table columns in :mod:`sim.engine.kinematics`). Every ``rebase_every``
-events all disks are brought to the current time and the clock restarts from zero (its
-origin kept in ``accumulators[T_ORIGIN]``), so long runs keep full float64 precision. Stale
-events are re-predicted, never applied. At large N the loop waits on memory: it asks the CPU
-to prefetch the partner's data and that of the next disks in the queue, and for states larger
-than the caches several events ahead (:func:`prefetch_upcoming`, :mod:`sim.engine.prefetch`).
+Positions are advanced lazily: disk i is stored at ``table[i, X:Y+1]`` at its own time
+``table[i, T_OWN]`` (disk table columns in :mod:`sim.engine.kinematics`). Every
+``rebase_every`` events all disks are brought to the current time and the clock restarts from
+zero (its origin kept in ``accumulators[T_ORIGIN]``), so long runs keep full float64
+precision. Stale events are re-predicted, never applied. At large N the loop waits on memory:
+it asks the CPU to prefetch the partner's data and that of the next disks in the queue, and for
+states larger than the caches several events ahead (:func:`prefetch_upcoming`,
+:mod:`sim.engine.prefetch`).
 
-Optional effects arrive as arguments that are either ``None`` or a value; numba compiles one
-loop per combination and removes the code of every effect that is ``None``:
-``restitution`` float64[s, s] per species pair, ``wall_restitution`` float, ``tc`` float;
-``gravity`` float64[2] (:mod:`sim.effects.gravity`, :mod:`sim.engine.flight`); wall ``motion``
-float64[4, 3] and wall ``temperature`` float64[4] (:mod:`sim.effects.walls`); winding counts
-``images`` int32[n, 2] (:mod:`sim.engine.flight`); ``virial_tensor`` float64[3] and ``event_log``
-float64[capacity, 6] with ``log_fill`` int64[1] (:mod:`sim.effects.recorders`).
-Likewise ``mass``, ``species`` and ``delta`` are arrays only when the disks differ in them, and
-otherwise one number (:func:`sim.engine.parameters.per_disk`).
+Words: a *contact* is a disk touching a disk (a *collision*) or a wall (a *wall contact*); an
+*event* is what the loop applies: a contact or a shell exit. Stale events and first
+predictions are popped from the queue but are no events.
 
-The loop returns ``(status, disk)``; errors are codes, raised as exceptions by the caller.
+The loop takes its arguments in named groups (:mod:`sim.engine.groups`); the effects a scene
+uses arrive in :class:`sim.effects.Effects`, each None when off, and act through the rules of
+their modules (:mod:`sim.effects.rules`): numba compiles one loop per combination and removes
+the code of every effect that is off. It returns ``(status, disk)``; errors are codes, raised
+as exceptions by the caller.
 """
 
 import math
@@ -35,11 +34,16 @@ import math
 import numpy as np
 from numba import njit
 
+from sim.effects.event_log import log_contact
 from sim.effects.gravity import shell_exit
-from sim.effects.recorders import add_virial_tensor, log_contact
-from sim.effects.walls import contact_key, hit_wall, predict_wall_contact
+from sim.effects.pressure_tensor import add_virial_tensor
+from sim.effects.restitution import collapsing, disk_restitution, wall_restitution_of
+from sim.effects.tc import tc_restitution
+from sim.effects.thermal_walls import contact_key
+from sim.effects.walls import hit_wall, predict_wall_contact
+from sim.engine.box import PERIODIC, SIDE
 from sim.engine.contact import collide_disks
-from sim.engine.flight import displacement, fly, position_at, velocity_at
+from sim.engine.flight import flown, fly, position_at, velocity_of
 from sim.engine.kinematics import (
     CX,
     CY,
@@ -89,11 +93,11 @@ STATUS_LIST_FULL = -2
 STATUS_STALLED = -3
 
 # counters: int64[N_COUNTERS]
-EVENTS = 0  # applied events: disk and wall contacts and shell exits
-DISK_COLLISIONS = 1
-WALL_COLLISIONS = 2
+EVENTS = 0  # applied events: contacts and shell exits
+COLLISIONS = 1  # disk–disk contacts
+WALL_CONTACTS = 2
 SHELL_EXITS = 3
-STALE_EVENTS = 4
+STALE_EVENTS = 4  # popped, found stale, dropped
 N_COUNTERS = 5
 
 # accumulators: float64[N_ACCUMULATORS]
@@ -101,14 +105,13 @@ T_ORIGIN = 0  # absolute time of the clock's zero
 T_NOW = 1  # time of the last event, relative to T_ORIGIN
 DISSIPATED_DISKS = 2
 DISSIPATED_WALLS = 3
-VIRIAL = 4  # Σ r_ij·Δp_i over disk contacts
+VIRIAL = 4  # Σ r_ij·Δp_i over collisions
 WALL_WORK = 5  # work done by moving and thermal walls on the disks
 N_ACCUMULATORS = 6
 
 
 @njit(cache=True, inline="always")
-def predict(i, t, disks, delta, coll_count, event_time, nb_start, nb_count, nb, geometry, grid,
-            gravity, motion, t_origin):
+def predict(i, t, disks, schedule, neighbours, box, effects, t_origin):
     """The earliest event of disk i, which must be at time t already (``t_origin``: the
     absolute time of the clock's zero, which moving walls need): its time, its partner (a
     disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's collision count when
@@ -124,39 +127,43 @@ def predict(i, t, disks, delta, coll_count, event_time, nb_start, nb_count, nb, 
     0.32 → 0.14 at 0.7), and ``benchmarks/compare_builds.py`` 1.047 at N = 1e4, φ = 0.5,
     1.034 at 0.1, 1.032 at 0.7, 1.050 at N = 1e5.
     """
-    px = grid[2] != 0
-    py = grid[3] != 0
-    x = disks[i, X]
-    y = disks[i, Y]
-    vx = disks[i, VX]
-    vy = disks[i, VY]
-    r_i = disks[i, RADIUS]
-    tau = shell_exit(minimum_image(x - disks[i, CX], geometry[0], px),
-                     minimum_image(y - disks[i, CY], geometry[1], py), vx, vy,
-                     per_disk(delta, i), gravity)
+    table = disks.table
+    geometry, grid = box
+    gravity = effects.gravity
+    px = grid[PERIODIC] != 0
+    py = grid[PERIODIC + 1] != 0
+    x = table[i, X]
+    y = table[i, Y]
+    vx = table[i, VX]
+    vy = table[i, VY]
+    r_i = table[i, RADIUS]
+    tau = shell_exit(gravity, minimum_image(x - table[i, CX], geometry[SIDE], px),
+                     minimum_image(y - table[i, CY], geometry[SIDE + 1], py), vx, vy,
+                     per_disk(disks.delta, i))
     partner = SHELL_EXIT
     for axis in range(2):
-        if grid[2 + axis] == 0:
-            tau_w, side = predict_wall_contact(axis, t_origin + t, disks[i, X + axis],
-                                               disks[i, VX + axis], r_i, geometry, gravity,
-                                               motion, tau)
+        if grid[PERIODIC + axis] == 0:
+            tau_w, side = predict_wall_contact(gravity, effects.wall_motion, axis, t_origin + t,
+                                               table[i, X + axis], table[i, VX + axis], r_i,
+                                               geometry, tau)
             if tau_w < tau:
                 tau = tau_w
                 # a search near a vibrating wall that stopped short: predict again from there
                 partner = WALL_X_LOW - 2 * axis - side if side >= 0 else SHELL_EXIT
-    start = list_start(nb_start, i)
-    for k in range(start, start + nb_count[i]):
+    nb = neighbours.nb
+    event_time = schedule.event_time
+    start = list_start(neighbours.nb_start, i)
+    for k in range(start, start + neighbours.nb_count[i]):
         j = nb[k]
-        dt = t - disks[j, T_OWN]
-        vx_j = velocity_at(j, 0, dt, disks, gravity)
-        vy_j = velocity_at(j, 1, dt, disks, gravity)
-        rx = minimum_image(x - disks[j, X] - displacement(j, 0, dt, disks, gravity),
-                           geometry[0], px)
-        ry = minimum_image(y - disks[j, Y] - displacement(j, 1, dt, disks, gravity),
-                           geometry[1], py)
+        dt = t - table[j, T_OWN]
+        vx_j = velocity_of(j, 0, dt, table, gravity)
+        vy_j = velocity_of(j, 1, dt, table, gravity)
+        rx = minimum_image(x - table[j, X] - flown(j, 0, dt, table, gravity), geometry[SIDE], px)
+        ry = minimum_image(y - table[j, Y] - flown(j, 1, dt, table, gravity), geometry[SIDE + 1],
+                           py)
         vx_ij = vx - vx_j
         vy_ij = vy - vy_j
-        sigma = r_i + disks[j, RADIUS]
+        sigma = r_i + table[j, RADIUS]
         if may_touch_before(rx, ry, vx_ij, vy_ij, sigma, tau):
             tau_ij = pair_contact_time(rx, ry, vx_ij, vy_ij, sigma)
             if tau_ij < tau and t + tau_ij <= event_time[j]:
@@ -164,24 +171,22 @@ def predict(i, t, disks, delta, coll_count, event_time, nb_start, nb_count, nb, 
                 partner = j
     if tau == INF:
         partner = NO_EVENT
-    return t + tau, partner, coll_count[partner] if partner >= 0 else np.int32(0)
+    return t + tau, partner, disks.coll_count[partner] if partner >= 0 else np.int32(0)
 
 
 @njit(cache=True, inline="always")
-def set_event(i, when, partner, partner_count, event_time, event_partner, event_count):
+def set_event(i, when, partner, partner_count, schedule):
     """Record the event :func:`predict` found for disk i; filing it in the queue
     (:func:`sim.engine.queue.reschedule`) comes after."""
-    event_time[i] = when
-    event_partner[i] = partner
+    schedule.event_time[i] = when
+    schedule.event_partner[i] = partner
     if partner >= 0:
-        event_count[i] = partner_count
+        schedule.event_count[i] = partner_count
 
 
 @njit(cache=True, inline="always")
-def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, coll_count,
-                      event_time, event_partner, event_count, heap, links, list_head, calendar,
-                      nb_start, nb_count, nb, cell_head, cell_next, cell_prev, cell_of, geometry,
-                      grid):
+def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule, neighbours,
+                      box):
     """Ask the CPU to start loading what the next events will read while this one is worked on
     (hints only: no result changes). A disk's data is hinted in stages, one event apart, each
     stage reading what the one before brought in: the partner of this event and the disks of
@@ -205,20 +210,24 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
     them (on a day a miss took 200 ns): 1.135 at N = 1e5 (1.03–1.20), 1.26 at φ = 0.1, 1.20
     at 1e6 (1.13–1.33).
     """
+    table, coll_count = disks.table, disks.coll_count
+    event_partner, event_count, heap, links = (schedule.event_partner, schedule.event_count,
+                                               schedule.heap, schedule.links)
+    nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
     if partner >= 0:
-        prefetch(disks, partner)
+        prefetch(table, partner)
         prefetch(coll_count, partner)
         prefetch(links, partner)
         start = list_start(nb_start, partner)
         prefetch(nb, start)
         if lookahead:
             for k in range(start, start + nb_count[partner]):
-                prefetch(disks, nb[k])
+                prefetch(table, nb[k])
                 prefetch(coll_count, nb[k])
-    size = calendar[HEAP_SIZE]
+    size = schedule.calendar[HEAP_SIZE]
     for slot in range(1, min(4 if lookahead else 3, size)):
         c = heap[slot]
-        prefetch(disks, c)
+        prefetch(table, c)
         prefetch(event_partner, c)
         prefetch(nb, list_start(nb_start, c))
         if lookahead:
@@ -233,30 +242,79 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, delta, co
         partner_c = event_partner[c]
         start = list_start(nb_start, c)
         for k in range(start, start + nb_count[c]):
-            prefetch(disks, nb[k])
+            prefetch(table, nb[k])
             prefetch(coll_count, nb[k])
             if partner_c == SHELL_EXIT:
                 prefetch(nb, list_start(nb_start, nb[k]))
                 prefetch(nb_count, nb[k])
         if partner_c >= 0:
-            prefetch(disks, partner_c)
+            prefetch(table, partner_c)
             prefetch(nb, list_start(nb_start, partner_c))
             prefetch(nb_count, partner_c)
             prefetch(coll_count, partner_c)
             prefetch(event_count, partner_c)
         elif partner_c == SHELL_EXIT:
-            prefetch(cell_of, c)
-            prefetch(cell_prev, c)
-            cx, cy = shell_centre(c, disks, delta, geometry, grid)
-            prefetch_cells(cx, cy, slot == 1, disks, cell_head, cell_next, geometry, grid)
-    walker, walker_block = prefetch_next_block(walker, walker_block, links, list_head,
-                                               calendar, event_time)
+            prefetch(neighbours.cell_of, c)
+            prefetch(neighbours.cell_prev, c)
+            cx, cy = shell_centre(c, table, disks.delta, box.geometry, box.grid)
+            prefetch_cells(cx, cy, slot == 1, table, neighbours.cell_head, neighbours.cell_next,
+                           box.geometry, box.grid)
+    walker, walker_block = prefetch_next_block(walker, walker_block, links, schedule.list_head,
+                                               schedule.calendar, schedule.event_time)
     if walker >= 0:
-        prefetch(disks, walker)
+        prefetch(table, walker)
         prefetch(event_partner, walker)
         prefetch(nb, list_start(nb_start, walker))
         prefetch(nb_count, walker)
     return walker, walker_block
+
+
+@njit(cache=True, inline="always")
+def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
+    """The collision of disks i and j, both already flown to time t, as the ``contact``-th
+    contact of the run: restitution (with the TC model), the impulse
+    (:func:`sim.engine.contact.collide_disks`), what the recorders keep, the collapse watch.
+    Returns (energy dissipated, r·Δp_i, log full, the disk found collapsing or −1)."""
+    table, t_last = disks.table, disks.t_last
+    geometry, grid = box
+    rx = minimum_image(table[i, X] - table[j, X], geometry[SIDE], grid[PERIODIC] != 0)
+    ry = minimum_image(table[i, Y] - table[j, Y], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
+    xi = tc_restitution(effects.tc, disk_restitution(effects.restitution, disks.species, i, j),
+                        t, t_last[i], t_last[j])
+    lost, virial = collide_disks(i, j, rx, ry, xi, table, per_disk(disks.mass, i),
+                                 per_disk(disks.mass, j))
+    add_virial_tensor(effects.virial_tensor, rx, ry, virial)
+    s_i = per_disk(disks.species, i)
+    s_j = per_disk(disks.species, j)
+    tallies.pair_collisions[min(s_i, s_j), max(s_i, s_j)] += 1
+    disks.coll_count[i] += 1
+    disks.coll_count[j] += 1
+    log_full = log_contact(effects.event_log, t_origin + t, i, j,
+                           virial / math.sqrt(rx * rx + ry * ry), lost, contact)
+    collapsing_i = collapsing(effects.collapse, t_last, disks.streak, i, xi, t)
+    collapsing_j = collapsing(effects.collapse, t_last, disks.streak, j, xi, t)
+    culprit = i if collapsing_i else (j if collapsing_j else -1)
+    return lost, virial, log_full, culprit
+
+
+@njit(cache=True, inline="always")
+def touch_wall(i, wall, t, t_origin, disks, box, effects, tallies, wall_contacts, contact):
+    """Disk i, flown to time t, touches ``wall`` as the run's ``wall_contacts``-th wall contact
+    (counted from 0) and ``contact``-th contact: restitution (with the TC model), the wall's
+    rule (:func:`sim.effects.walls.hit_wall`), the log, the collapse watch. Returns (energy
+    dissipated, work done by the wall, log full, collapsing)."""
+    t_last = disks.t_last
+    xi_w = tc_restitution(effects.tc, wall_restitution_of(effects.wall_restitution), t,
+                          t_last[i], t_last[i])
+    key = contact_key(effects.wall_temperature, effects.seed, wall_contacts)
+    lost, impulse, work = hit_wall(i, wall, t_origin + t, xi_w, disks.table,
+                                   per_disk(disks.mass, i), box.geometry, effects.wall_motion,
+                                   effects.wall_temperature, key, effects.gravity, effects.tc)
+    tallies.wall_impulse[wall] += impulse
+    disks.coll_count[i] += 1
+    log_full = log_contact(effects.event_log, t_origin + t, i, -1 - wall, abs(impulse), lost,
+                           contact)
+    return lost, work, log_full, collapsing(effects.collapse, t_last, disks.streak, i, xi_w, t)
 
 
 @njit(cache=True, inline="always")
@@ -275,56 +333,87 @@ def count_all_contacts(coll_count, contacts):
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links, list_head,
-                 calendar, block_rate, geometry, grid, gravity, images, accumulators):
+def rebase_clock(disks, schedule, box, effects, accumulators):
     """Bring every disk to the current time and restart the clock there (order-preserving);
     the event queue is rebuilt for the shifted times, and the contact counts are updated."""
-    count_contacts(coll_count, contacts)
+    count_contacts(disks.coll_count, disks.contacts)
     t0 = accumulators[T_NOW]
-    for i in range(disks.shape[0]):
-        fly(i, t0, disks, geometry, grid, gravity, images)
-        disks[i, T_OWN] = 0.0
-        t_last[i] -= t0
-        event_time[i] -= t0
+    table = disks.table
+    for i in range(table.shape[0]):
+        fly(i, t0, table, box.geometry, box.grid, effects.gravity, effects.images)
+        table[i, T_OWN] = 0.0
+        disks.t_last[i] -= t0
+        schedule.event_time[i] -= t0
     accumulators[T_ORIGIN] += t0
     accumulators[T_NOW] = 0.0
-    build_queue(heap, links, list_head, calendar, block_rate, event_time, 0.0)
+    build_queue(schedule.heap, schedule.links, schedule.list_head, schedule.calendar,
+                schedule.block_rate, schedule.event_time, 0.0)
+
+
+@njit(cache=True, inline="always")
+def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origin):
+    """Predict the next event of disk i and, when j ≥ 0, of disk j, and file both.
+
+    One call site each for predict and reschedule: numba inlines them wherever they are
+    called, and with one copy instead of five the loop compiles about four times faster.
+    Both disks are predicted before either is filed, so that the bucket head a filing reads
+    is on its way while the second prediction runs (no prediction reads the queue). The queue
+    sees one event time change at a time, as a filing compares times: the event of j is
+    recorded only once i is filed."""
+    s = schedule
+    moved_disks = 1 if j < 0 else 2
+    when, whom, whose_count = INF, NO_EVENT, np.int32(0)
+    for k in range(moved_disks):
+        when, whom, whose_count = predict(i if k == 0 else j, t, disks, schedule, neighbours,
+                                          box, effects, t_origin)
+        prefetch_bucket(s.list_head, s.calendar, s.block_rate, when)
+        if k == 0:
+            set_event(i, when, whom, whose_count, schedule)
+    for k in range(moved_disks):
+        if k == 1:  # the prediction of j, the last one made
+            set_event(j, when, whom, whose_count, schedule)
+        reschedule(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time,
+                   i if k == 0 else j)
+
+
+@njit(cache=True, inline="always")
+def limit_reached(limits, events, collisions, wall_contacts, dissipated, log_full):
+    """The status of the first limit of ``limits`` the tallies have reached, else 0."""
+    if events >= limits.max_events:
+        return STATUS_EVENT_LIMIT
+    if collisions >= limits.max_collisions:
+        return STATUS_COLLISION_LIMIT
+    if collisions + wall_contacts >= limits.max_contacts:
+        return STATUS_CONTACT_LIMIT
+    if dissipated >= limits.dissipation_limit:
+        return STATUS_ENERGY_REACHED
+    if log_full:
+        return STATUS_LOG_FULL
+    return 0
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak, event_time,
-               event_partner, event_count, heap, links, list_head, calendar, block_rate,
-               nb_start, nb_cap, nb_count, nb, cell_head, cell_next, cell_prev, cell_of, big,
-               geometry, grid, restitution, wall_restitution, tc, gravity, motion, temperature,
-               seed, images, virial_tensor, event_log, log_fill,
-               counters, accumulators, pair_collisions, wall_impulse,
-               max_events, max_contacts, max_collisions, t_stop, dissipation_limit,
-               collapse_dt, collapse_streak, stall_dt, stall_watch, rebase_every, lookahead):
+def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
     """Process events in time order until a limit is met; see the module docstring.
 
-    Limits: ``max_events`` (applied events, shell exits included: the chunk size),
-    ``max_contacts`` (disk and wall contacts) and ``max_collisions`` (disk contacts) are
-    totals of ``counters``, ``t_stop`` is an
-    absolute time (events after it stay scheduled), ``dissipation_limit`` the energy whose
-    dissipation ends the run. Inelastic collapse: a disk with more than ``collapse_streak``
-    consecutive dissipative contacts, each less than ``collapse_dt`` after its previous
-    contact (contacts made elastic by the TC model break the streak). A stall — more than
-    16 N + 1000 events in a row, each at most ``stall_dt`` after the one before (a time of
-    float64 resolution, :data:`sim.engine.core.STALL_RESOLUTION`) — ends the loop instead of
-    hanging it; ``stall_watch`` float64[2] holds the time of the last event popped (relative
-    clock) and the length of that run, carried from one call to the next.
-
-    ``lookahead``: prefetch several events ahead, and the candidates of a shell exit's cell
-    scan, for states larger than the caches (:func:`prefetch_upcoming`,
-    :func:`sim.engine.neighbours._prefetch_candidates`).
+    Limits (:class:`sim.engine.groups.Limits`): ``max_events`` (events: the chunk size),
+    ``max_contacts`` and ``max_collisions`` are totals of ``tallies.counters``; ``t_stop`` is
+    an absolute time (events after it stay scheduled); ``dissipation_limit`` the energy whose
+    dissipation ends the run. A stall — more than 16 N + 1000 events in a row, each at most
+    ``stall_dt`` after the one before (a time of float64 resolution,
+    :data:`sim.engine.core.STALL_RESOLUTION`) — ends the loop instead of hanging it;
+    ``tallies.stall_watch`` holds the time of the last event popped (relative clock) and the
+    length of that run, carried from one call to the next. ``lookahead``: prefetch several
+    events ahead, and the candidates of a shell exit's cell scan, for states larger than the
+    caches (:func:`prefetch_upcoming`, :func:`sim.engine.neighbours._prefetch_candidates`).
 
     Counters and accumulators live in local variables (registers) during the loop and are
-    written back to ``counters`` and ``accumulators`` when it stops.
+    written back to ``tallies`` when it stops.
     """
-    dissipative = restitution is not None or wall_restitution is not None
+    counters, accumulators = tallies.counters, tallies.accumulators
     events = counters[EVENTS]
-    disk_collisions = counters[DISK_COLLISIONS]
-    wall_collisions = counters[WALL_COLLISIONS]
+    collisions = counters[COLLISIONS]
+    wall_contacts = counters[WALL_CONTACTS]
     shell_exits = counters[SHELL_EXITS]
     stale_events = counters[STALE_EVENTS]
     t_now = accumulators[T_NOW]
@@ -333,176 +422,91 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     virial_sum = accumulators[VIRIAL]
     wall_work = accumulators[WALL_WORK]
     log_full = False
-    t_stop_rel = t_stop - accumulators[T_ORIGIN]
-    events_to_rebase = rebase_every - events % rebase_every
+    t_stop = limits.t_stop - accumulators[T_ORIGIN]
+    events_to_rebase = limits.rebase_every - events % limits.rebase_every
     status = 0
     culprit = -1
-    t_previous = stall_watch[0]
-    stalled = np.int64(stall_watch[1])
-    stall_limit = 16 * disks.shape[0] + 1000
+    t_previous = tallies.stall_watch[0]
+    stalled = np.int64(tallies.stall_watch[1])
+    stall_limit = 16 * disks.table.shape[0] + 1000
     walker = -1  # the queue's look-ahead (prefetch_next_block)
     walker_block = -1
+    s = schedule
     while True:
-        i = earliest(heap, links, list_head, calendar, block_rate, event_time)
-        partner = event_partner[i]
+        i = earliest(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time)
+        partner = s.event_partner[i]
         if partner != UNPREDICTED:  # a first prediction is made whatever the limits
-            if events >= max_events:
-                status = STATUS_EVENT_LIMIT
+            status = limit_reached(limits, events, collisions, wall_contacts,
+                                   dissipated_disks + dissipated_walls, log_full)
+            if status != 0:
                 break
-            if disk_collisions >= max_collisions:
-                status = STATUS_COLLISION_LIMIT
-                break
-            if disk_collisions + wall_collisions >= max_contacts:
-                status = STATUS_CONTACT_LIMIT
-                break
-            if dissipated_disks + dissipated_walls >= dissipation_limit:
-                status = STATUS_ENERGY_REACHED
-                break
-            if log_full:
-                status = STATUS_LOG_FULL
-                break
-        t = event_time[i]
-        if t > t_stop_rel:
+        t = s.event_time[i]
+        if t > t_stop:
             status = STATUS_TIME_REACHED
             break
         if t == INF:
             status = STATUS_NO_EVENTS
             break
-        if t - t_previous <= stall_dt:
-            stalled += 1
-            if stalled > stall_limit:
-                status = STATUS_STALLED
-                culprit = i
-                break
-        else:
-            stalled = 0
+        stalled = stalled + 1 if t - t_previous <= limits.stall_dt else 0
+        if stalled > stall_limit:
+            status = STATUS_STALLED
+            culprit = i
+            break
         t_previous = t
-        walker, walker_block = prefetch_upcoming(
-            partner, lookahead, walker, walker_block, disks, delta, coll_count, event_time,
-            event_partner, event_count, heap, links, list_head, calendar, nb_start, nb_count, nb,
-            cell_head, cell_next, cell_prev, cell_of, geometry, grid)
-        fly(i, t, disks, geometry, grid, gravity, images)
-        j = partner  # the second disk to re-predict, when it is a disk contact
-        if partner >= 0 and coll_count[j] != event_count[i]:
+        walker, walker_block = prefetch_upcoming(partner, limits.lookahead, walker, walker_block,
+                                                 disks, schedule, neighbours, box)
+        t_origin = accumulators[T_ORIGIN]
+        fly(i, t, disks.table, box.geometry, box.grid, effects.gravity, effects.images)
+        j = NO_EVENT  # the second disk to re-predict, when it is a collision
+        if partner >= 0 and disks.coll_count[partner] != s.event_count[i]:
             stale_events += 1
-            j = NO_EVENT
         elif partner >= 0:
-            fly(j, t, disks, geometry, grid, gravity, images)
-            rx = minimum_image(disks[i, X] - disks[j, X], geometry[0], grid[2] != 0)
-            ry = minimum_image(disks[i, Y] - disks[j, Y], geometry[1], grid[3] != 0)
-            xi = 1.0
-            if restitution is not None:
-                xi = restitution[per_disk(species, i), per_disk(species, j)]
-                if tc is not None:
-                    if t - t_last[i] < tc or t - t_last[j] < tc:
-                        xi = 1.0
-            lost, virial = collide_disks(i, j, rx, ry, xi, disks, per_disk(mass, i),
-                                         per_disk(mass, j))
+            j = partner
+            fly(j, t, disks.table, box.geometry, box.grid, effects.gravity, effects.images)
+            collisions += 1
+            events += 1
+            lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
+                                                      tallies, collisions + wall_contacts)
             dissipated_disks += lost
             virial_sum += virial
-            if virial_tensor is not None:
-                add_virial_tensor(virial_tensor, rx, ry, virial)
-            s_i = per_disk(species, i)
-            s_j = per_disk(species, j)
-            if s_i <= s_j:
-                pair_collisions[s_i, s_j] += 1
-            else:
-                pair_collisions[s_j, s_i] += 1
-            coll_count[i] += 1
-            coll_count[j] += 1
-            disk_collisions += 1
-            events += 1
-            if event_log is not None:
-                log_full = log_contact(event_log, log_fill, accumulators[T_ORIGIN] + t, i, j,
-                                       virial / math.sqrt(rx * rx + ry * ry), lost,
-                                       disk_collisions + wall_collisions)
-            if dissipative:
-                for d in (i, j):
-                    streak[d] = streak[d] + 1 if (xi < 1.0 and t - t_last[d] < collapse_dt) else 0
-                    t_last[d] = t
-                if streak[i] > collapse_streak or streak[j] > collapse_streak:
-                    status = STATUS_COLLAPSE
-                    culprit = i if streak[i] > collapse_streak else j
-                    break
-        elif partner == UNPREDICTED:
-            pass  # nothing happens: the disk is only predicted below
         elif partner == SHELL_EXIT:
-            full = rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb,
-                                      cell_head, cell_next, cell_prev, cell_of, big, geometry,
-                                      grid, lookahead)
-            if full >= 0:
+            nbs = neighbours
+            culprit = rebuild_neighbours(i, disks.table, disks.delta, nbs.nb_start, nbs.nb_cap,
+                                         nbs.nb_count, nbs.nb, nbs.cell_head, nbs.cell_next,
+                                         nbs.cell_prev, nbs.cell_of, nbs.big, box.geometry,
+                                         box.grid, limits.lookahead)
+            if culprit >= 0:
                 status = STATUS_LIST_FULL
-                culprit = full
                 break
             shell_exits += 1
             events += 1
-        else:
-            wall = WALL_X_LOW - partner
-            xi_w = 1.0
-            if wall_restitution is not None:
-                xi_w = wall_restitution
-                if tc is not None:
-                    if t - t_last[i] < tc:
-                        xi_w = 1.0
-            key = np.uint64(0)
-            if temperature is not None:
-                key = contact_key(seed, wall_collisions)
-            lost, impulse, work = hit_wall(i, wall, accumulators[T_ORIGIN] + t, xi_w, disks,
-                                           per_disk(mass, i), geometry, motion, temperature, key,
-                                           gravity, tc)
+        elif partner != UNPREDICTED:
+            wall_contacts += 1
+            events += 1
+            lost, work, log_full, collapsed = touch_wall(
+                i, WALL_X_LOW - partner, t, t_origin, disks, box, effects, tallies,
+                wall_contacts - 1, collisions + wall_contacts)
             dissipated_walls += lost
             wall_work += work
-            wall_impulse[wall] += impulse
-            coll_count[i] += 1
-            wall_collisions += 1
-            events += 1
-            if event_log is not None:
-                log_full = log_contact(event_log, log_fill, accumulators[T_ORIGIN] + t, i,
-                                       -1 - wall, abs(impulse), lost,
-                                       disk_collisions + wall_collisions)
-            if dissipative:
-                streak[i] = streak[i] + 1 if (xi_w < 1.0 and t - t_last[i] < collapse_dt) else 0
-                t_last[i] = t
-                if streak[i] > collapse_streak:
-                    status = STATUS_COLLAPSE
-                    culprit = i
-                    break
-        # One call site each for predict and reschedule: numba inlines them wherever they are
-        # called, and with one copy instead of five the loop compiles about four times faster.
-        # Both disks are predicted before either is filed, so that the bucket head a filing
-        # reads is on its way while the second prediction runs (no prediction reads the
-        # queue). The queue sees one event time change at a time, as a filing compares times:
-        # the event of j is recorded only once i is filed.
-        moved_disks = 1 if j < 0 else 2
-        when, whom, whose_count = INF, NO_EVENT, np.int32(0)
-        for k in range(moved_disks):
-            when, whom, whose_count = predict(i if k == 0 else j, t, disks, delta, coll_count,
-                                              event_time, nb_start, nb_count, nb, geometry,
-                                              grid, gravity, motion, accumulators[T_ORIGIN])
-            prefetch_bucket(list_head, calendar, block_rate, when)
-            if k == 0:
-                set_event(i, when, whom, whose_count, event_time, event_partner, event_count)
-        for k in range(moved_disks):
-            if k == 1:  # the prediction of j, the last one made
-                set_event(j, when, whom, whose_count, event_time, event_partner, event_count)
-            reschedule(heap, links, list_head, calendar, block_rate, event_time,
-                       i if k == 0 else j)
+            culprit = i if collapsed else -1
+        if culprit >= 0:
+            status = STATUS_COLLAPSE
+            break
+        predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origin)
         if (partner >= 0 and j < 0) or partner == UNPREDICTED:
             continue  # a stale event or a first prediction is no event: the clock stays
         t_now = t
         events_to_rebase -= 1
         if events_to_rebase == 0:
             accumulators[T_NOW] = t_now
-            rebase_clock(disks, coll_count, contacts, t_last, event_time, heap, links,
-                         list_head, calendar, block_rate, geometry, grid, gravity, images,
-                         accumulators)
+            rebase_clock(disks, schedule, box, effects, accumulators)
             t_now = 0.0
             t_previous = 0.0  # this event's time, on the restarted clock
-            t_stop_rel = t_stop - accumulators[T_ORIGIN]
-            events_to_rebase = rebase_every
+            t_stop = limits.t_stop - accumulators[T_ORIGIN]
+            events_to_rebase = limits.rebase_every
     counters[EVENTS] = events
-    counters[DISK_COLLISIONS] = disk_collisions
-    counters[WALL_COLLISIONS] = wall_collisions
+    counters[COLLISIONS] = collisions
+    counters[WALL_CONTACTS] = wall_contacts
     counters[SHELL_EXITS] = shell_exits
     counters[STALE_EVENTS] = stale_events
     accumulators[T_NOW] = t_now
@@ -510,25 +514,25 @@ def run_events(disks, delta, mass, species, coll_count, contacts, t_last, streak
     accumulators[DISSIPATED_WALLS] = dissipated_walls
     accumulators[VIRIAL] = virial_sum
     accumulators[WALL_WORK] = wall_work
-    stall_watch[0] = t_previous
-    stall_watch[1] = stalled
+    tallies.stall_watch[0] = t_previous
+    tallies.stall_watch[1] = stalled
     return status, culprit
 
 
 @njit(cache=True)
-def state_at(t, disks, geometry, grid, gravity):
+def state_at(t, table, geometry, grid, gravity):
     """Positions and velocities of all disks at time t (relative clock), without changing
     the state.
 
     Returns (position float64[n, 2] wrapped into the periodic box, velocity float64[n, 2]).
     """
-    n = disks.shape[0]
+    n = table.shape[0]
     position = np.empty((n, 2))
     velocity = np.empty((n, 2))
     for i in range(n):
-        dt = t - disks[i, T_OWN]
+        dt = t - table[i, T_OWN]
         for axis in range(2):
-            position[i, axis] = wrap(position_at(i, axis, dt, disks, gravity), geometry[axis],
-                                     grid[2 + axis] != 0)
-            velocity[i, axis] = velocity_at(i, axis, dt, disks, gravity)
+            position[i, axis] = wrap(position_at(i, axis, dt, table, gravity),
+                                     geometry[SIDE + axis], grid[PERIODIC + axis] != 0)
+            velocity[i, axis] = velocity_of(i, axis, dt, table, gravity)
     return position, velocity

@@ -25,9 +25,7 @@ Arrays (n disks):
   loaded, and the neighbours of a disk are one load closer;
   cell_head int32[ncx*ncy], cell_next int32[n], cell_prev int32[n], cell_of int32[n] (-1 big);
   big int32[n_big];
-  geometry float64[6] = (Lx, Ly, cell width x, cell width y, largest small R + δ, lead λ of
-  :func:`shell_centre`);
-  grid int64[4] = (cells along x, cells along y, periodic x, periodic y).
+  geometry float64[6] and grid int64[4] — the box and its cells (:mod:`sim.engine.box`).
 """
 
 import math
@@ -36,6 +34,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from sim.engine.box import CELL_SIDE, CELLS, LEAD, PERIODIC, REACH, SIDE
 from sim.engine.kinematics import (
     CX,
     CY,
@@ -72,11 +71,11 @@ SHELL_SLACK = 1e-9
 @njit(cache=True, inline="always")
 def cell_index(x, y, geometry, grid):
     """Cell holding the point (x, y); points on or beyond the box edge go to the edge cell."""
-    ix = int(x / geometry[2])
-    iy = int(y / geometry[3])
-    ix = min(max(ix, 0), grid[0] - 1)
-    iy = min(max(iy, 0), grid[1] - 1)
-    return iy * grid[0] + ix
+    ix = int(x / geometry[CELL_SIDE])
+    iy = int(y / geometry[CELL_SIDE + 1])
+    ix = min(max(ix, 0), grid[CELLS] - 1)
+    iy = min(max(iy, 0), grid[CELLS + 1] - 1)
+    return iy * grid[CELLS] + ix
 
 
 @njit(cache=True, inline="always")
@@ -125,8 +124,8 @@ def _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
     changes sign with the order, so the test gives the same answer for (i, j) and (j, i) to the
     last bit: the lists hold exactly the overlapping pairs, which the rebuild relies on.
     """
-    dx = minimum_image(cx - disks[j, CX], geometry[0], grid[2] != 0)
-    dy = minimum_image(cy - disks[j, CY], geometry[1], grid[3] != 0)
+    dx = minimum_image(cx - disks[j, CX], geometry[SIDE], grid[PERIODIC] != 0)
+    dy = minimum_image(cy - disks[j, CY], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
     reach_i = disks[i, RADIUS] + per_disk(delta, i)
     reach_j = disks[j, RADIUS] + per_disk(delta, j)
     reach = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
@@ -188,8 +187,8 @@ def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, gr
     and 0.5; 1.04 and 1.01 at 2e4; 1.00 and 0.99 at 3e4. Hence the hints only with the
     look-ahead (:data:`sim.engine.core.LOOKAHEAD_MIN_DISKS`).
     """
-    ncx = grid[0]
-    ncy = grid[1]
+    ncx = grid[CELLS]
+    ncy = grid[CELLS + 1]
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
         for ax in range(x_lo, x_hi):
@@ -219,18 +218,18 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     ``hint_candidates`` as a bool from Python, never a literal, so that they share one
     specialisation): 3.5 s less of the first compilation, and 2.8 s more for a literal.
     """
-    ncx = grid[0]
-    ncy = grid[1]
+    ncx = grid[CELLS]
+    ncy = grid[CELLS + 1]
     c = cell_index(cx, cy, geometry, grid)
     if cell_of[i] >= 0:
         kx = 1
         ky = 1
     else:
-        reach = disks[i, RADIUS] + per_disk(delta, i) + geometry[4]
-        kx = int(math.ceil(reach / geometry[2]))
-        ky = int(math.ceil(reach / geometry[3]))
-    x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[2] != 0)
-    y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[3] != 0)
+        reach = disks[i, RADIUS] + per_disk(delta, i) + geometry[REACH]
+        kx = int(math.ceil(reach / geometry[CELL_SIDE]))
+        ky = int(math.ceil(reach / geometry[CELL_SIDE + 1]))
+    x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[PERIODIC] != 0)
+    y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[PERIODIC + 1] != 0)
     free = list_start(nb_start, i) + nb_count[i]
     room = per_disk(nb_cap, i) - nb_count[i]
     if hint_candidates:
@@ -261,11 +260,11 @@ def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
     cells. With ``members``: the heads are read (they should be in cache by now) and for each
     cell the head and the disk numbered before it are hinted (after a renumbering by cell the
     disks of a cell carry consecutive numbers, so that one is mostly a cell-mate)."""
-    ncx = grid[0]
-    ncy = grid[1]
+    ncx = grid[CELLS]
+    ncy = grid[CELLS + 1]
     c = cell_index(x, y, geometry, grid)
-    x_lo, x_hi = _axis_span(c % ncx, 1, ncx, grid[2] != 0)
-    y_lo, y_hi = _axis_span(c // ncx, 1, ncy, grid[3] != 0)
+    x_lo, x_hi = _axis_span(c % ncx, 1, ncx, grid[PERIODIC] != 0)
+    y_lo, y_hi = _axis_span(c // ncx, 1, ncy, grid[PERIODIC + 1] != 0)
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
         if not members:
@@ -284,7 +283,7 @@ def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
 @njit(cache=True, inline="always")
 def shell_centre(i, disks, delta, geometry, grid):
     """Centre (cx, cy) of a new shell for disk i: ahead of the disk along its velocity by
-    λ δ_i, λ = ``geometry[5]`` < 1, wrapped into a periodic box.
+    λ δ_i, λ = ``geometry[LEAD]`` < 1, wrapped into a periodic box.
 
     Any centre within δ_i of the disk is valid; one ahead of a disk in free flight lets it
     cross (1 + λ) δ_i instead of δ_i before it leaves the shell, so a dilute gas, whose disks
@@ -294,10 +293,10 @@ def shell_centre(i, disks, delta, geometry, grid):
     vx = disks[i, VX]
     vy = disks[i, VY]
     speed_squared = vx * vx + vy * vy
-    lead = (geometry[5] * per_disk(delta, i) / math.sqrt(speed_squared)
+    lead = (geometry[LEAD] * per_disk(delta, i) / math.sqrt(speed_squared)
             if speed_squared > TINY_SPEED_SQUARED else 0.0)
-    return (wrap(disks[i, X] + lead * vx, geometry[0], grid[2] != 0),
-            wrap(disks[i, Y] + lead * vy, geometry[1], grid[3] != 0))
+    return (wrap(disks[i, X] + lead * vx, geometry[SIDE], grid[PERIODIC] != 0),
+            wrap(disks[i, Y] + lead * vy, geometry[SIDE + 1], grid[PERIODIC + 1] != 0))
 
 
 @njit(cache=True, inline="always")

@@ -52,7 +52,8 @@ from PIL import Image
 from sim.analysis.datasets import open_run
 from sim.analysis.observers import Clusters
 from sim.effects.gravity import gravity_vector
-from sim.effects.walls import NAMES, wall_motion, wall_state
+from sim.effects.walls import wall_motion, wall_state
+from sim.engine.box import WALL_NAMES
 from sim.pipeline.command import BadInput, CannotWrite, Parser, run_command
 from sim.storage.inspect import RunFileError
 
@@ -170,15 +171,17 @@ class Walls:
     def __init__(self, config, box, periodic):
         self.box = box
         self.periodic = periodic
-        specs = {k: (config.get("walls") or {}).get(name) or {} for k, name in enumerate(NAMES)}
-        self.motion = wall_motion({k: spec for k, spec in specs.items() if not periodic[k >> 1]})
+        specs = {k: (config.get("walls") or {}).get(name) or {}
+                 for k, name in enumerate(WALL_NAMES)}
+        self.motion = wall_motion({k: spec for k, spec in specs.items()
+                                   if not periodic[k >> 1]})
         self.thermal = [specs[k].get("temperature") is not None for k in range(4)]
 
     def at(self, time):
         """Positions float64[4] of the walls (left, right, bottom, top) at ``time``."""
         if self.motion is None:
             return np.array([0.0, self.box[0], 0.0, self.box[1]])
-        return np.array([wall_state(k, time, self.box, self.motion)[0] for k in range(4)])
+        return np.array([wall_state(self.motion, k, time, self.box)[0] for k in range(4)])
 
     def view(self, times):
         """(x0, x1, y0, y1): the box and every place its walls reach at ``times``."""

@@ -13,7 +13,7 @@ Layout written by :class:`RunWriter`:
                               beside ``value``
   /events/contacts            when the scene logs events (``observe.event_log``): one row per
                               contact, columns time, disk, partner, impulse, dissipated,
-                              contact (:mod:`sim.effects.recorders`), written at every flush
+                              contact (:mod:`sim.effects.event_log`), written at every flush
   /parameters                 config (resolved YAML), overrides (YAML list), seed, preparation
                               (how the initial state was made, in words), versions,
                               git commit, stop reason; stop_message (a breakdown's), resumes
@@ -44,7 +44,7 @@ import numpy as np
 import yaml
 
 import sim
-from sim.effects.recorders import LOG_COLUMNS, LOG_CONTACT
+from sim.effects.event_log import LOG_COLUMNS, LOG_CONTACT
 from sim.storage.inspect import DAMAGE, RunFileError
 
 OBSERVABLES = {

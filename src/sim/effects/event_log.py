@@ -1,0 +1,34 @@
+"""The log of every contact, kept when a scene asks for it (``observe.event_log``).
+
+``event_log`` is a pair (rows float64[capacity, 6], fill int64[1]) — one row per contact:
+absolute time, disk i, partner j (a disk, or −1 − wall for a wall contact, walls numbered as
+in :mod:`sim.engine.box`), normal impulse |Δp| on i, energy dissipated, contacts so far;
+``fill`` is the number of rows in use — or None, and then no code of it is compiled. A full
+log stops the loop, which the engine drains and resumes: rows are in engine order and the
+engine renames the disks.
+"""
+
+from sim.effects.rules import effect_rule
+
+#: columns of the event log
+LOG_TIME, LOG_DISK, LOG_PARTNER, LOG_IMPULSE, LOG_DISSIPATED, LOG_CONTACT = range(6)
+LOG_COLUMNS = 6
+
+
+def _not_logged(event_log, t_abs, i, partner, impulse, lost, contact):
+    return False
+
+
+@effect_rule(_not_logged)
+def log_contact(event_log, t_abs, i, partner, impulse, lost, contact):
+    """Append one contact; returns True when the log is full afterwards."""
+    rows, fill = event_log
+    row = fill[0]
+    rows[row, LOG_TIME] = t_abs
+    rows[row, LOG_DISK] = i
+    rows[row, LOG_PARTNER] = partner
+    rows[row, LOG_IMPULSE] = impulse
+    rows[row, LOG_DISSIPATED] = lost
+    rows[row, LOG_CONTACT] = contact
+    fill[0] = row + 1
+    return row + 1 >= rows.shape[0]

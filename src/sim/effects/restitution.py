@@ -1,0 +1,92 @@
+"""Normal restitution: inelastic contacts, and the inelastic collapse they can end in.
+
+A contact reverses the normal relative velocity and shrinks it by ξ: v_n' = −ξ v_n
+(Brilliantov & Pöschel, *Kinetic Theory of Granular Gases*, §1; the smooth contact rule is
+:func:`sim.engine.contact.collide_disks`), losing (1 − ξ²) μ v_n²/2 of kinetic energy (μ the
+reduced mass). A scene gives ξ per species pair (``restitution`` float64[s, s]) and ξ_w for
+the walls (``wall_restitution`` float); each is None when elastic, and then no code of it is
+compiled (:mod:`sim.effects.rules`).
+
+Inelastic collapse (McNamara & Young, Phys. Fluids A 4, 496 (1992)): a group of disks that
+collide infinitely often in finite time. It is watched for whenever a contact may dissipate
+(``collapse`` = :class:`CollapseWatch`, else None): a disk with more than ``longest``
+consecutive dissipative contacts, each less than ``interval`` after its previous contact,
+ends the run with :class:`sim.engine.core.InelasticCollapseError`. The watch keeps the time of
+each disk's last contact (``t_last``), which the TC model (:mod:`sim.effects.tc`) reads.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+from sim.effects.rules import effect_rule
+from sim.engine.parameters import per_disk
+
+
+def restitution_matrix(restitution, n_species):
+    """ξ per species pair for the compiled loop: None for elastic contacts (the effect is
+    dropped), else a symmetric float64[s, s] with entries in [0, 1]."""
+    if restitution is None:
+        return None
+    xi = np.broadcast_to(np.asarray(restitution, dtype=np.float64), (n_species, n_species))
+    if not np.all((xi >= 0.0) & (xi <= 1.0)):
+        raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
+    if not np.array_equal(xi, xi.T):
+        raise ValueError(f"restitution matrix must be symmetric, got {xi.tolist()}")
+    if np.all(xi == 1.0):
+        return None
+    # always a fresh writable copy: numba types read-only arrays apart, so a view passed on
+    # for some inputs would compile the event loop a second time for the same effects
+    return np.array(xi)
+
+
+def wall_restitution_value(wall_restitution):
+    """ξ_w for the compiled loop: None for elastic walls, else a float in [0, 1)."""
+    if wall_restitution is not None and not 0.0 <= wall_restitution <= 1.0:
+        raise ValueError(f"wall_restitution must lie in [0, 1], got {wall_restitution}")
+    return (None if wall_restitution is None or wall_restitution == 1.0
+            else float(wall_restitution))
+
+
+class CollapseWatch(NamedTuple):
+    """The inelastic-collapse detector: more than ``longest`` consecutive dissipative contacts
+    of one disk, each less than ``interval`` (time units) after its previous contact."""
+    interval: float
+    longest: int
+
+
+def _elastic(restitution, species, i, j):
+    return 1.0
+
+
+@effect_rule(_elastic)
+def disk_restitution(restitution, species, i, j):
+    """ξ of a contact between disks i and j: that of their species pair."""
+    return restitution[per_disk(species, i), per_disk(species, j)]
+
+
+def _elastic_wall(wall_restitution):
+    return 1.0
+
+
+@effect_rule(_elastic_wall)
+def wall_restitution_of(wall_restitution):
+    """ξ_w of a wall contact."""
+    return wall_restitution
+
+
+def _unwatched(collapse, t_last, streak, d, xi, t):
+    return False
+
+
+@effect_rule(_unwatched)
+def collapsing(collapse, t_last, streak, d, xi, t):
+    """Record a contact of disk d with restitution ξ at time t; True when d has now made more
+    than ``collapse.longest`` dissipative contacts in a row, each within
+    ``collapse.interval`` of the one before."""
+    if xi < 1.0 and t - t_last[d] < collapse.interval:
+        streak[d] += 1
+    else:
+        streak[d] = 0
+    t_last[d] = t
+    return streak[d] > collapse.longest

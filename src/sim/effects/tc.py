@@ -1,0 +1,39 @@
+"""The TC model (Luding & McNamara, Granular Matter 1, 113 (1998)): a contact is elastic when
+either partner touched anything — disk or wall — less than t_c ago.
+
+Inelastic disks can collapse (:mod:`sim.effects.restitution`): infinitely many contacts in
+finite time. Real grains in lasting contact do not dissipate as in a binary collision; the
+model makes contacts within a contact duration t_c of the one before elastic, which keeps
+dense or resting inelastic matter simulable. Wall contacts count, so a disk trapped between a
+wall and its neighbours cannot collapse against the wall either, and a disk resting on a
+floor under gravity leaves it as from a bounce lasting t_c
+(:func:`sim.effects.gravity.resting_lift`).
+
+``tc`` is a float, or None when the model is off or nothing dissipates (no code compiled,
+:mod:`sim.effects.rules`); it reads the contact times the collapse watch keeps.
+"""
+
+import math
+
+from sim.effects.rules import effect_rule
+
+
+def tc_time(tc, dissipative):
+    """t_c for the compiled loop: None when the model is off (None or 0) or no contact
+    dissipates, else a finite float > 0."""
+    if tc is not None and not 0.0 <= tc < math.inf:
+        raise ValueError(f"tc (the TC-model time) must be finite and ≥ 0, or None; got {tc}")
+    return float(tc) if (tc and dissipative) else None
+
+
+def _off(tc, xi, t, t_last_i, t_last_j):
+    return xi
+
+
+@effect_rule(_off)
+def tc_restitution(tc, xi, t, t_last_i, t_last_j):
+    """The restitution of a contact at time t whose partners last touched anything at
+    ``t_last_i`` and ``t_last_j`` (the same for a wall contact): 1 within t_c, else ξ."""
+    if t - t_last_i < tc or t - t_last_j < tc:
+        return 1.0
+    return xi

@@ -1,0 +1,78 @@
+"""The arguments of the compiled loop, in named groups.
+
+:func:`sim.engine.loop.run_events` takes seven tuples: what it reads and writes of the disks,
+the schedule of their events, the neighbour lists and cells, the box, the effects
+(:class:`sim.effects.Effects`), the running tallies and the limits of one call. numba
+passes a tuple's fields as separate arguments, so grouping costs nothing; fields are read by
+name, and a field that is a number where it could be an array (a mass every disk shares, one
+list capacity for all) compiles a variant that never loads the array
+(:func:`sim.engine.parameters.per_disk`).
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Disks(NamedTuple):
+    """Per-disk state (engine order; :mod:`sim.engine.state`)."""
+    table: np.ndarray  # float64[n, DISK_COLUMNS], columns in sim.engine.kinematics
+    delta: object  # float64[n] shell radii, or the one every disk shares
+    mass: object  # float64[n], or the one every disk shares
+    species: object  # int32[n], or the one every disk shares
+    coll_count: np.ndarray  # int32[n] contacts modulo 2³², the staleness counter
+    contacts: np.ndarray  # int64[n] contacts in full, updated at every rebase
+    t_last: np.ndarray  # float64[n] time of the last contact (collapse watch, TC)
+    streak: np.ndarray  # int32[n] consecutive fast dissipative contacts
+
+
+class Schedule(NamedTuple):
+    """Each disk's next event and the queue that orders them (:mod:`sim.engine.queue`)."""
+    event_time: np.ndarray  # float64[n], relative clock
+    event_partner: np.ndarray  # int32[n]: a disk, or a code of sim.engine.loop
+    event_count: np.ndarray  # int32[n]: the partner's coll_count at prediction
+    heap: np.ndarray
+    links: np.ndarray
+    list_head: np.ndarray
+    calendar: np.ndarray
+    block_rate: np.ndarray
+
+
+class Neighbours(NamedTuple):
+    """Neighbour lists and cells (:mod:`sim.engine.neighbours`)."""
+    nb_start: object  # int32[n] list starts, or the capacity every list shares
+    nb_cap: object  # int32[n] list capacities, or the capacity every list shares
+    nb_count: np.ndarray  # int32[n]
+    nb: np.ndarray  # int32[Σ capacity]
+    cell_head: np.ndarray
+    cell_next: np.ndarray
+    cell_prev: np.ndarray
+    cell_of: np.ndarray
+    big: np.ndarray  # int32[n_big] disks kept out of the cells
+
+
+class Box(NamedTuple):
+    """The box and its cells (:mod:`sim.engine.box`)."""
+    geometry: np.ndarray  # float64[GEOMETRY_SIZE]
+    grid: np.ndarray  # int64[GRID_SIZE]
+
+
+class Tallies(NamedTuple):
+    """What the loop counts and sums, carried from one call to the next."""
+    counters: np.ndarray  # int64[N_COUNTERS] (sim.engine.loop)
+    accumulators: np.ndarray  # float64[N_ACCUMULATORS] (sim.engine.loop)
+    pair_collisions: np.ndarray  # int64[s, s] collisions per species pair (upper triangle)
+    wall_impulse: np.ndarray  # float64[4] momentum given to each wall
+    stall_watch: np.ndarray  # float64[2] time of the last event popped, length of the run
+
+
+class Limits(NamedTuple):
+    """Where one call stops, and the guards of the loop (see run_events)."""
+    max_events: int
+    max_contacts: int
+    max_collisions: int
+    t_stop: float  # absolute time
+    dissipation_limit: float
+    stall_dt: float
+    rebase_every: int
+    lookahead: bool
