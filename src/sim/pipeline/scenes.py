@@ -1,17 +1,22 @@
 """Scenes: from a validated config to the initial state of the engine.
 
-Each scene is a function registered under its name (``@scene("crater", _bed_preparation)``)
-that returns a :class:`Scene`, with a function saying in words how it places its disks;
-adding a scene is adding them here and a YAML file in ``conf/scenario/``. Positions and
-velocities are float64[n, 2] in box units.
+Every scene is one :class:`SceneSpec` in :data:`SCENES`: its builder ``f(cfg) -> Scene``,
+how it places its disks in words, the schema sections it needs, the checks of its own keys,
+its fixed number of disks if it has one, and whether it is a gas filling the box. The
+config's list of scenes and its per-scene checks (:func:`sim.pipeline.config.validate`),
+:data:`BUILDERS` and :data:`PREPARATIONS` all come from it. Adding a scene is its builder
+and entry here, its section of the schema (:mod:`sim.pipeline.config`) if it has keys of its
+own, and ``conf/scenario/<name>.yaml``; ``tests/test_scene_registry.py`` checks that they
+agree. Positions and velocities are float64[n, 2] in box units.
 """
 
+import math
 from dataclasses import dataclass
+from typing import Callable, Optional
 
 import numpy as np
 
 from sim.engine.core import Boundary, Engine
-from sim.pipeline.config import ConfigError
 from sim.pipeline.initial import (
     MELT_COLLISIONS_PER_DISK,
     RSA_JAMMING,
@@ -24,12 +29,13 @@ from sim.pipeline.initial import (
     random_sequential,
     remove_drift,
 )
-
-BUILDERS = {}
+from sim.pipeline.rules import MAX_DISKS, ConfigError, pair, positive, resolvable, within
 
 
 @dataclass
 class Scene:
+    """An initial state: float64[n, 2] positions and velocities, radii, masses, species."""
+
     position: np.ndarray
     velocity: np.ndarray
     radius: np.ndarray
@@ -38,29 +44,33 @@ class Scene:
     boundary: Boundary
 
 
-#: scene name → ``f(cfg) -> str``: how the scene's initial state is made, in words
-PREPARATIONS = {}
+def _as_given(cfg):
+    return "placed as the scene's keys say"
 
 
-def scene(name, preparation=None):
-    """Register a scene builder ``f(cfg) -> Scene`` under ``name``, and ``preparation(cfg)``
-    saying how it places its disks (default: as the config gives them)."""
-    def register(builder):
-        BUILDERS[name] = builder
-        PREPARATIONS[name] = preparation or (lambda cfg: "placed as the scene's keys say")
-        return builder
-    return register
+def _no_checks(c):
+    """A scene without keys of its own."""
 
 
-def preparation(cfg):
-    """How the initial state of ``cfg``'s scene is made, in words (recorded in /parameters
-    as ``preparation`` and named on the figures)."""
-    return PREPARATIONS[cfg.scene](cfg)
+@dataclass(frozen=True)
+class SceneSpec:
+    """A scene: the name the config gives it, how it is built and described, and how its
+    keys are checked."""
 
-
-def build_scene(cfg):
-    """The initial state of the scene named by ``cfg.scene``."""
-    return BUILDERS[cfg.scene](cfg)
+    name: str
+    #: ``f(cfg) -> Scene``: the initial state
+    builder: Callable
+    #: ``f(cfg) -> str``: how the initial state is made, in words
+    preparation: Callable = _as_given
+    #: the optional sections of the schema the scene needs (``bed``, ``projectile``, …)
+    sections: tuple = ()
+    #: ``f(c)``: :class:`ConfigError` on the first bad key of the scene's own, once the keys
+    #: every scene shares and the presence of :attr:`sections` are checked
+    check: Callable = _no_checks
+    #: the number of disks the scene always has, which ``disks.n`` must not contradict
+    fixed_count: Optional[int] = None
+    #: a gas: ``disks.n`` disks fill the box at ``disks.packing_fraction``
+    gas_like: bool = False
 
 
 def _boundary(cfg):
@@ -134,7 +144,6 @@ def _gas_preparation(cfg):
             + (", zero total momentum" if d.zero_momentum else ""))
 
 
-@scene("gas", _gas_preparation)
 def gas(cfg):
     n = cfg.disks.n
     radius = _gas_radius(cfg)
@@ -143,11 +152,24 @@ def gas(cfg):
                  np.zeros(n, np.int32), _boundary(cfg))
 
 
-scene("cooling", _gas_preparation)(gas)
-scene("driven", _gas_preparation)(gas)
+def _check_mixture(c):
+    """One mass per species, fractions that sum to 1 and give every species a disk."""
+    m, n = c.mixture, c.disks.n
+    if len(m.masses) != len(m.fractions) or len(m.masses) < 1:
+        raise ConfigError("mixture.masses", list(m.masses),
+                          "one mass per entry of mixture.fractions")
+    if any(not (x > 0) for x in m.masses):
+        raise ConfigError("mixture.masses", list(m.masses), "positive masses")
+    if any(not (x > 0) for x in m.fractions) or abs(sum(m.fractions) - 1.0) > 1e-9:
+        raise ConfigError("mixture.fractions", list(m.fractions),
+                          "positive fractions that sum to 1")
+    counts = [math.floor(x * n) for x in m.fractions]
+    if min(counts[1:], default=1) < 1:
+        raise ConfigError("mixture.fractions", list(m.fractions),
+                          f"fractions that give every species at least one of the "
+                          f"disks.n={n} disks (a species gets floor(fraction × n))")
 
 
-@scene("mixture", _gas_preparation)
 def mixture(cfg):
     base = gas(cfg)
     n = cfg.disks.n
@@ -161,7 +183,6 @@ def mixture(cfg):
     return base
 
 
-@scene("single_disk")
 def single_disk(cfg):
     radius = _gas_radius(cfg)
     ly = float(cfg.box.size[1])
@@ -171,16 +192,42 @@ def single_disk(cfg):
                  np.array([float(cfg.disks.mass)]), np.zeros(1, np.int32), _boundary(cfg))
 
 
-@scene("two_disks")
+def _check_two_disks(c):
+    """Two positions and two velocities; the disks apart, across a periodic side too."""
+    position = pair(c, "two_disks.positions", "two points [[x, y], [x, y]]")
+    pair(c, "two_disks.velocities", "two velocities [[vx, vy], [vx, vy]]")
+    if c.disks.radius is None:
+        raise ConfigError("disks.radius", None, "the radius of the two disks")
+    box = np.array([float(x) for x in c.box.size])
+    r = position[0] - position[1]
+    if c.box.boundary == "periodic":
+        r -= box * np.round(r / box)
+    if np.hypot(*r) < 2.0 * c.disks.radius:
+        raise ConfigError("two_disks.positions", position.tolist(),
+                          f"two points [[x, y], [x, y]] at least 2 R = "
+                          f"{2.0 * c.disks.radius:.6g} apart (the disks must not overlap)")
+
+
 def two_disks(cfg):
-    """Positions and velocities as given, checked by :func:`sim.pipeline.config.validate`."""
+    """Positions and velocities as given, checked by :func:`_check_two_disks`."""
     radius = _gas_radius(cfg)
     return Scene(np.array(cfg.two_disks.positions, dtype=np.float64),
                  np.array(cfg.two_disks.velocities, dtype=np.float64), np.full(2, radius),
                  np.full(2, float(cfg.disks.mass)), np.zeros(2, np.int32), _boundary(cfg))
 
 
-@scene("scattering")
+def _check_scattering(c):
+    """A target of positive size and mass; an impact parameter up to the contact distance."""
+    s, radius = c.scattering, c.disks.radius
+    positive("scattering.target_radius", s.target_radius, allow_none=False)
+    resolvable(c, "scattering.target_radius", s.target_radius)
+    positive("scattering.target_mass", s.target_mass, allow_none=False)
+    if radius is None:
+        raise ConfigError("disks.radius", None, "the scattering projectile needs a radius")
+    within("scattering.impact_parameter", s.impact_parameter, 0.0, s.target_radius + radius,
+           f"between 0 and the contact distance {s.target_radius + radius}")
+
+
 def scattering(cfg):
     s = cfg.scattering
     lx, ly = (float(x) for x in cfg.box.size)
@@ -194,6 +241,23 @@ def scattering(cfg):
                  np.array([0, 1], np.int32), _boundary(cfg))
 
 
+def _check_bed(c):
+    """Bed disks of positive size and mass, in a bed at most 0.85 full inside the box."""
+    b = c.bed
+    positive("bed.radius", b.radius, allow_none=False)
+    resolvable(c, "bed.radius", b.radius)
+    positive("bed.mass", b.mass, allow_none=False)
+    if not 1 <= b.n < MAX_DISKS:
+        raise ConfigError("bed.n", b.n, f"from 1 to {MAX_DISKS - 1} disks")
+    lx, ly = c.box.size
+    within("bed.height", b.height, 1e-12, ly, f"between 0 and the box height {ly}")
+    bed_phi = b.n * math.pi * b.radius**2 / (lx * b.height)
+    if bed_phi > 0.85:
+        raise ConfigError("bed.n", b.n, f"at most a packing fraction of 0.85 in the bed "
+                          f"region (this is {bed_phi:.3f}): fewer or smaller bed disks, or "
+                          f"a higher bed.height")
+
+
 def _bed_region(cfg):
     return (0.0, float(cfg.box.size[0])), (0.0, float(cfg.bed.height))
 
@@ -204,15 +268,24 @@ def _bed(cfg):
     return _place(cfg, float(b.radius), int(b.n), region=_bed_region(cfg), key="bed.n")
 
 
-def _bed_preparation(cfg):
+def _bed_placement(cfg):
     b = cfg.bed
-    placed = PLACEMENTS[_placement(cfg, int(b.n), float(b.radius), _bed_region(cfg))]
-    if cfg.scene == "crater" and b.settle_time is not None:
-        return f"bed: {placed}, then settled for t = {b.settle_time} under gravity"
-    return f"bed: {placed}, at rest"
+    return PLACEMENTS[_placement(cfg, int(b.n), float(b.radius), _bed_region(cfg))]
 
 
-@scene("vibrated_bed", _bed_preparation)
+def _bed_preparation(cfg):
+    return f"bed: {_bed_placement(cfg)}, at rest"
+
+
+def _check_vibrated_bed(c):
+    """The bed, which starts where it is placed."""
+    _check_bed(c)
+    if c.bed.settle_time is not None:
+        raise ConfigError("bed.settle_time", c.bed.settle_time,
+                          "null: the vibrated bed starts at rest where it is placed (only the "
+                          "crater scene settles its bed first)")
+
+
 def vibrated_bed(cfg):
     b = cfg.bed
     n = int(b.n)
@@ -232,7 +305,36 @@ def _settled(cfg, position):
     return engine.positions(b.settle_time), engine.velocities(b.settle_time)
 
 
-@scene("crater", _bed_preparation)
+def _crater_preparation(cfg):
+    settle_time = cfg.bed.settle_time
+    if settle_time is None:
+        return _bed_preparation(cfg)
+    return f"bed: {_bed_placement(cfg)}, then settled for t = {settle_time} under gravity"
+
+
+def _check_crater(c):
+    """The bed and its settling under gravity; the projectile inside the box, above the bed."""
+    _check_bed(c)
+    p, b = c.projectile, c.bed
+    positive("bed.settle_time", b.settle_time)
+    if b.settle_time is not None and not any(c.gravity):
+        raise ConfigError("bed.settle_time", b.settle_time,
+                          "null without gravity (nothing settles); set gravity=[0,-1]")
+    positive("projectile.radius", p.radius, allow_none=False)
+    resolvable(c, "projectile.radius", p.radius)
+    positive("projectile.speed", p.speed, zero=True, allow_none=False)
+    positive("projectile.mass", p.mass)
+    lx, ly = c.box.size
+    x, y = p.position
+    if not (p.radius <= x <= lx - p.radius and p.radius <= y <= ly - p.radius):
+        raise ConfigError("projectile.position", list(p.position),
+                          f"inside the box, at least projectile.radius={p.radius} from "
+                          f"every wall")
+    if y - p.radius < b.height and b.settle_time is None:
+        raise ConfigError("projectile.position", list(p.position),
+                          f"above the bed (bed.height={b.height}) by at least its radius")
+
+
 def crater(cfg):
     p, b = cfg.projectile, cfg.bed
     bed = _bed(cfg)
@@ -253,3 +355,38 @@ def crater(cfg):
     mass = np.append(np.full(n - 1, float(b.mass)), projectile_mass)
     species = np.append(np.zeros(n - 1, np.int32), 1).astype(np.int32)
     return Scene(position, velocity, radius, mass, species, _boundary(cfg))
+
+
+#: every scene, by name, in the order the config lists them
+SCENES = {spec.name: spec for spec in (
+    SceneSpec("single_disk", single_disk, fixed_count=1),
+    SceneSpec("two_disks", two_disks, sections=("two_disks",), check=_check_two_disks,
+              fixed_count=2),
+    SceneSpec("scattering", scattering, sections=("scattering",), check=_check_scattering,
+              fixed_count=2),
+    SceneSpec("gas", gas, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("mixture", mixture, preparation=_gas_preparation, sections=("mixture",),
+              check=_check_mixture, gas_like=True),
+    SceneSpec("crater", crater, preparation=_crater_preparation,
+              sections=("projectile", "bed"), check=_check_crater),
+    SceneSpec("cooling", gas, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("driven", gas, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("vibrated_bed", vibrated_bed, preparation=_bed_preparation, sections=("bed",),
+              check=_check_vibrated_bed),
+)}
+
+#: scene name → ``f(cfg) -> Scene``
+BUILDERS = {name: spec.builder for name, spec in SCENES.items()}
+#: scene name → ``f(cfg) -> str``: how the scene's initial state is made, in words
+PREPARATIONS = {name: spec.preparation for name, spec in SCENES.items()}
+
+
+def preparation(cfg):
+    """How the initial state of ``cfg``'s scene is made, in words (recorded in /parameters
+    as ``preparation`` and named on the figures)."""
+    return PREPARATIONS[cfg.scene](cfg)
+
+
+def build_scene(cfg):
+    """The initial state of the scene named by ``cfg.scene``."""
+    return BUILDERS[cfg.scene](cfg)
