@@ -16,7 +16,7 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
 from sim.pipeline.initial import RSA_JAMMING
-from sim.pipeline.rules import (
+from sim.pipeline.input_checks import (
     LARGEST,
     MAX_COUNT,
     MAX_DISKS,

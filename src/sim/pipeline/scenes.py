@@ -29,7 +29,7 @@ from sim.pipeline.initial import (
     random_sequential,
     remove_drift,
 )
-from sim.pipeline.rules import MAX_DISKS, ConfigError, pair, positive, resolvable, within
+from sim.pipeline.input_checks import MAX_DISKS, ConfigError, pair, positive, resolvable, within
 
 
 @dataclass
