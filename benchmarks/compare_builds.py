@@ -30,7 +30,7 @@ def worker(source, n, phi):
     tree = Path(tree).resolve()
     sys.path[:0] = [str(tree / "src"), str(tree / "benchmarks")]
     from engine_rate import equal_disks
-    from sim.engine.core import Boundary, Engine
+    from sim.engine import Boundary, Engine
 
     position, velocity, radius = equal_disks(n, phi)
     engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),

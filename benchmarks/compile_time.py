@@ -32,8 +32,8 @@ def report(n, phi, passes):
     from numba.core import event
 
     from engine_rate import equal_disks
+    from sim.engine import Boundary, Engine
     from sim.engine import loop as event_loop
-    from sim.engine.core import Boundary, Engine
 
     position, velocity, radius = equal_disks(n, phi)
     started = time.perf_counter()

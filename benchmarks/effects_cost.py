@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.pipeline.initial import fixed_speed, hexagonal_lattice, radius_for_packing
 
 #: effect: (options of the base scene, absent, neutral, on); the species rows label half the

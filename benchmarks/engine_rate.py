@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from sim.checks.reference import ReferenceEngine
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from engine_rate import equal_disks
-from sim.engine.core import Boundary, Engine, shell_ratio
+from sim.engine import Boundary, Engine
 from sim.engine.kinematics import (
     may_touch_before,
     minimum_image,
@@ -34,6 +34,7 @@ from sim.engine.kinematics import (
     wrap,
 )
 from sim.engine.queue import build_queue, earliest, empty_queue, reschedule
+from sim.engine.sizing import shell_ratio
 
 SHELL_EXIT = -2
 

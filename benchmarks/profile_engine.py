@@ -72,7 +72,7 @@ def profile(n, phi, collisions, frequency, folder):
     """Run the engine under ``perf record``; return the sampled addresses and the compiled
     functions."""
     from engine_rate import equal_disks
-    from sim.engine.core import Boundary, Engine
+    from sim.engine import Boundary, Engine
 
     position, velocity, radius = equal_disks(n, phi)
     engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)))

@@ -9,7 +9,7 @@ from hypothesis import settings
 
 from sim.checks.audit import outside_box, overlapping_pairs
 from sim.checks.validation import table
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,

@@ -15,7 +15,7 @@ from sim.analysis.crater import (
     occupied_cells,
 )
 from sim.analysis.datasets import open_run
-from sim.engine.core import Engine
+from sim.engine import Engine
 from sim.figures.runs import compose_config
 from sim.pipeline.initial import hexagonal_lattice
 from sim.pipeline.runner import run

@@ -8,18 +8,17 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import assert_no_overlap, gas
-from sim.engine.core import (
-    TIMED_FIRST_CHUNK,
+from sim.engine import (
     Boundary,
     ClosedBoxError,
     Engine,
     InelasticCollapseError,
     PhysicsBreakdown,
     StalledError,
-    cell_limit,
-    first_overlap,
-    grid_cells,
 )
+from sim.engine.overlap import first_overlap
+from sim.engine.running import TIMED_FIRST_CHUNK
+from sim.engine.sizing import cell_limit, grid_cells
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,
@@ -38,7 +37,7 @@ def refused(match, *args, **options):
 
 # -- 1. the input is checked ----------------------------------------------------------------
 def brute_first_overlap(position, radius, box, periodic, tolerance=1e-9):
-    """The definition of :func:`sim.engine.core.first_overlap`, pair by pair."""
+    """The definition of :func:`sim.engine.overlap.first_overlap`, pair by pair."""
     for i in range(len(radius)):
         r = position[i] - position[:i]
         r -= np.where(periodic, box * np.round(r / box), 0.0)

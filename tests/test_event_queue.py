@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.engine.queue import CURRENT_BLOCK, HEAP_SIZE, NEXT, NOT_IN_HEAP, PREV, SLOT, YEAR_END
 from sim.pipeline.initial import fixed_speed, random_sequential
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_no_overlap, gas
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.pipeline.runner import build_engine
 from test_pipeline import SCENARIOS, compose_scene
 

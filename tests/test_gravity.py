@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_no_overlap
-from sim.engine.core import Boundary, Engine, InelasticCollapseError, StalledError
+from sim.engine import Boundary, Engine, InelasticCollapseError, StalledError
 from sim.pipeline.initial import hexagonal_lattice, radius_for_packing, random_sequential
 
 G = 9.81

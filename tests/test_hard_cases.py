@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from conftest import assert_no_overlap, gas
 from sim.checks.audit import overlapping_pairs
-from sim.engine.core import Boundary, Engine, InelasticCollapseError
+from sim.engine import Boundary, Engine, InelasticCollapseError
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,

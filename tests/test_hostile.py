@@ -895,7 +895,7 @@ def _engine_case(name):
 @pytest.mark.parametrize("name", ["overlap", "outside", "nan-velocity", "nan-position",
                                   "inf-velocity"])
 def test_the_engine_refuses_a_bad_disk_naming_it(name):
-    from sim.engine.core import Engine
+    from sim.engine import Engine
 
     position, velocity = _engine_case(name)
     with pytest.raises(ValueError) as error:
@@ -907,7 +907,7 @@ def test_the_engine_refuses_a_bad_disk_naming_it(name):
 
 
 def test_the_engine_refuses_a_bad_mass_or_radius_naming_the_disk():
-    from sim.engine.core import Engine
+    from sim.engine import Engine
 
     position, velocity = _engine_case("none")
     for options in ({"mass": [1.0, float("inf"), 1.0]}, {"mass": [1.0, -1.0, 1.0]}):

@@ -76,7 +76,7 @@ def periodic_gas(tmp_path, *overrides):
 def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
     """The windings the loop counts agree with unwrapping snapshots so close in time that no
     disk moves half a box between them; a lone disk is ballistic across many box lengths."""
-    from sim.engine.core import Boundary, Engine
+    from sim.engine import Boundary, Engine
     from sim.pipeline.initial import radius_for_packing, random_sequential
 
     n = 200
@@ -179,7 +179,7 @@ def test_event_log_holds_every_contact(tmp_path):
 def test_event_log_streams_to_the_file_between_snapshots(tmp_path):
     """A run that logs much between snapshots does not hold the log in memory: each full
     buffer of the loop goes to the writer, which writes it once it holds buffer_bytes."""
-    from sim.engine.core import Engine
+    from sim.engine import Engine
     from sim.pipeline.initial import fixed_speed, radius_for_packing, random_sequential
     from sim.storage.h5md import RunWriter
 

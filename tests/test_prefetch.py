@@ -6,7 +6,7 @@ import pytest
 from numba import njit
 from numba.core.errors import TypingError
 
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.engine.prefetch import prefetch
 from sim.pipeline.initial import fixed_speed, random_sequential
 

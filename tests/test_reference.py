@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from conftest import assert_no_overlap
 from sim.checks.reference import ReferenceEngine
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 from sim.pipeline.initial import fixed_speed, hexagonal_lattice, radius_for_packing
 
 BOUNDARIES = [(False, False), (True, True), (True, False)]

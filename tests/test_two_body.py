@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sim.engine.core import Boundary, Engine
+from sim.engine import Boundary, Engine
 
 # (m1, m2, b/a, ξ): projectile m1 moving along +x at speed v, target m2 at rest
 CASES = [

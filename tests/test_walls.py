@@ -9,7 +9,7 @@ from scipy import stats
 
 from conftest import assert_no_overlap
 from sim.effects.walls import wall_state
-from sim.engine.core import Boundary, ClosedBoxError, Engine, InelasticCollapseError
+from sim.engine import Boundary, ClosedBoxError, Engine, InelasticCollapseError
 from sim.pipeline.initial import fixed_speed, radius_for_packing, random_sequential
 
 ALL_THERMAL = {name: {"temperature": 2.0} for name in ("left", "right", "bottom", "top")}

@@ -43,7 +43,7 @@ from sim.checks.validation import (
     kolafa_rottner_z,
     virial_blocks,
 )
-from sim.engine.core import Boundary, Engine, InelasticCollapseError
+from sim.engine import Boundary, Engine, InelasticCollapseError
 from sim.figures.crater_runs import crater_overrides
 from sim.figures.runs import compose_config, ensure_run
 from sim.pipeline.initial import (

@@ -21,7 +21,8 @@ from scipy.optimize import brentq
 
 from sim.analysis.datasets import granular_temperatures
 from sim.analysis.theory import garzo_dufty_temperature_ratio
-from sim.engine.core import Boundary, Engine
+from sim.engine.core import Engine
+from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,

@@ -11,7 +11,7 @@ Inelastic collapse (McNamara & Young, Phys. Fluids A 4, 496 (1992)): a group of 
 collide infinitely often in finite time. It is watched for whenever a contact may dissipate
 (``collapse`` = :class:`CollapseWatch`, else None): a disk with more than ``longest``
 consecutive dissipative contacts, each less than ``interval`` after its previous contact,
-ends the run with :class:`sim.engine.core.InelasticCollapseError`. The watch keeps the time of
+ends the run with :class:`sim.engine.errors.InelasticCollapseError`. The watch keeps the time of
 each disk's last contact (``t_last``), which the TC model (:mod:`sim.effects.tc`) reads.
 """
 

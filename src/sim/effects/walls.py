@@ -34,6 +34,11 @@ from sim.engine.kinematics import (
     wall_contact_time,
 )
 
+#: A piston (a wall moving at constant speed) that has raised the kinetic energy this many
+#: times above max(initial energy, N m U²) has jammed the disks against the opposite wall:
+#: driven at constant speed, their collision rate and energy diverge at a finite time.
+PISTON_ENERGY_LIMIT = 1e6
+
 #: A disk within this fraction of the box side of a vibrating wall (a few units of round-off),
 #: and closing, touches it.
 CONTACT_TOLERANCE = 1e-15
@@ -54,6 +59,45 @@ def wall_motion(walls):
                              f"frequency {frequency} must be finite, amplitude and frequency ≥ 0")
     motion[motion[:, 2] == 0.0, 1] = 0.0  # no frequency, no oscillation
     return motion if np.any(motion[:, :2]) else None
+
+
+def closing_time(motion, box, periodic, largest_radius):
+    """The absolute time at which moving walls could come closer to the opposite wall than
+    the largest disk diameter (inf when they never do): the gap along each walled axis is at
+    least L + (U_high − U_low) t − A_low − A_high."""
+    if motion is None:
+        return math.inf
+    closing = math.inf
+    for axis in range(2):
+        if periodic[axis]:
+            continue
+        low, high = motion[2 * axis], motion[2 * axis + 1]
+        room = box[axis] - low[1] - high[1] - 2.0 * largest_radius
+        if room <= 0.0:
+            raise ValueError(f"the walls of axis {'xy'[axis]} oscillate with amplitudes "
+                             f"{low[1]} and {high[1]} in a box {box[axis]} wide: they would "
+                             f"crush disks of radius {largest_radius}")
+        rate = low[0] - high[0]
+        if rate > 0.0:
+            closing = min(closing, room / rate)
+    return closing
+
+
+def piston_jam(motion, initial_energy, total_mass, kinetic_energy, time):
+    """The message of a piston that has jammed the disks, or None: a wall moving at constant
+    speed U that has raised the kinetic energy (``kinetic_energy()``, asked only when a wall
+    moves so) above :data:`PISTON_ENERGY_LIMIT` times max(initial energy, N m U²)."""
+    if motion is None or not np.any(motion[:, 0]):
+        return None
+    speed = float(np.abs(motion[:, 0]).max())
+    scale = max(initial_energy, total_mass * speed**2)
+    kinetic_energy = kinetic_energy()
+    if kinetic_energy <= PISTON_ENERGY_LIMIT * scale:
+        return None
+    return (f"at t = {time:.6g} the piston has jammed the disks: their kinetic energy "
+            f"{kinetic_energy:.3g} is {kinetic_energy / scale:.3g} times max(initial energy, "
+            f"N m U²), and a wall driven at constant speed makes it diverge; stop the run "
+            f"earlier (stop.time) or slow the piston")
 
 
 def _still(motion, wall):
@@ -149,7 +193,7 @@ def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, motion, temperature, k
     wall on the disk), so that E_kin changes by work − dissipated. A disk found receding
     from the wall (round-off) keeps its velocity, unless it rests on a floor under gravity
     and the TC model (:func:`sim.effects.gravity.resting_lift`); without that model such a
-    disk stalls the clock (:class:`sim.engine.core.StalledError`).
+    disk stalls the clock (:class:`sim.engine.errors.StalledError`).
     """
     axis = wall >> 1
     other = 1 - axis

@@ -7,9 +7,9 @@ looked up on first use, so that the compiled modules can import one another with
 the engine's Python side.
 """
 
-_PUBLIC = {"Engine": "sim.engine.core", "Boundary": "sim.engine.core",
-           "PhysicsBreakdown": "sim.engine.core", "StalledError": "sim.engine.core",
-           "ClosedBoxError": "sim.engine.core", "InelasticCollapseError": "sim.engine.core"}
+_PUBLIC = {"Engine": "sim.engine.core", "Boundary": "sim.engine.inputs",
+           "PhysicsBreakdown": "sim.engine.errors", "StalledError": "sim.engine.errors",
+           "ClosedBoxError": "sim.engine.errors", "InelasticCollapseError": "sim.engine.errors"}
 
 __all__ = sorted(_PUBLIC)
 

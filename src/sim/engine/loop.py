@@ -201,7 +201,7 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule,
 
     Against the hints without ``lookahead`` (``benchmarks/compare_builds.py``, φ = 0.5): 1.49
     at N = 1e5, 1.39 at 1e6, 1.11 at 5e4, but 0.94 at 3e4, where the state still sits mostly
-    in cache (hence :data:`sim.engine.core.LOOKAHEAD_MIN_DISKS`). The hints for the walked disks'
+    in cache (hence :data:`sim.engine.sizing.LOOKAHEAD_MIN_DISKS`). The hints for the walked disks'
     rows, partners and lists, with blocks of 8 mean event times instead of 4
     (:data:`sim.engine.queue.BLOCK_EVENTS`), against neither: 1.07, 1.12 and 1.11 at N = 1e5
     (quartiles of rounds 0.98–1.17, 1.04–1.22, 1.05–1.17), 1.05 at 1e6 (1.02–1.12). The
@@ -401,7 +401,7 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
     an absolute time (events after it stay scheduled); ``dissipation_limit`` the energy whose
     dissipation ends the run. A stall — more than 16 N + 1000 events in a row, each at most
     ``stall_dt`` after the one before (a time of float64 resolution,
-    :data:`sim.engine.core.STALL_RESOLUTION`) — ends the loop instead of hanging it;
+    :data:`sim.engine.sizing.STALL_RESOLUTION`) — ends the loop instead of hanging it;
     ``tallies.stall_watch`` holds the time of the last event popped (relative clock) and the
     length of that run, carried from one call to the next. ``lookahead``: prefetch several
     events ahead, and the candidates of a shell exit's cell scan, for states larger than the

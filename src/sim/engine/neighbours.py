@@ -185,7 +185,7 @@ def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, gr
     0.5 MiB and 38 ns at 4 MiB, the scan without hints beat it while the state fits the
     caches: 1.10, 1.03 and 1.02 at 1e4, φ = 0.1, 0.5 and 0.7; 1.13 and 1.06 at 1e3, φ = 0.1
     and 0.5; 1.04 and 1.01 at 2e4; 1.00 and 0.99 at 3e4. Hence the hints only with the
-    look-ahead (:data:`sim.engine.core.LOOKAHEAD_MIN_DISKS`).
+    look-ahead (:data:`sim.engine.sizing.LOOKAHEAD_MIN_DISKS`).
     """
     ncx = grid[CELLS]
     ncy = grid[CELLS + 1]

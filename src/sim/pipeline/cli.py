@@ -39,7 +39,7 @@ from omegaconf import OmegaConf
 from omegaconf.errors import KeyValidationError, ValidationError
 
 from sim.__main__ import caused_by_a_signal, leave
-from sim.engine.core import PhysicsBreakdown
+from sim.engine.errors import PhysicsBreakdown
 from sim.pipeline import callbacks, resources
 from sim.pipeline.config import ConfigError, integer_keys, register, validate
 from sim.pipeline.run_folder import FolderBusyError, RunLock, new_folder

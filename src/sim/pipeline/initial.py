@@ -211,7 +211,8 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
     ``collisions_per_disk`` collisions per disk, i.e. n × collisions_per_disk / 2 disk–disk
     collisions): hard walls at the region's edges, periodic along an axis the region spans
     in a periodic box. Deterministic in ``seed``."""
-    from sim.engine.core import Boundary, Engine  # the engine prepares, it does not place
+    from sim.engine.core import Engine
+    from sim.engine.inputs import Boundary  # the engine prepares, it does not place
 
     lo, hi = _region(region, box)
     wraps = tuple(bool(periodic[a]) and lo[a] == 0.0 and hi[a] == box[a] for a in range(2))

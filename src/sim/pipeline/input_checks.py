@@ -5,15 +5,15 @@ the checks that :func:`sim.pipeline.config.validate` and the scenes' own checks
 import numpy as np
 from omegaconf import OmegaConf
 
-from sim.engine.core import RESOLUTION_LIMIT, SCALE_LIMIT
+from sim.engine.inputs import RESOLUTION_LIMIT, SCALE_LIMIT
 
 #: Every dimensional number of a scene (a length, speed, mass, time, temperature or
 #: acceleration) is 0 or of a magnitude in [SMALLEST, LARGEST], the engine's own range
-#: (:data:`sim.engine.core.SCALE_LIMIT`): squares and products stay inside float64's.
+#: (:data:`sim.engine.inputs.SCALE_LIMIT`): squares and products stay inside float64's.
 SMALLEST, LARGEST = 1.0 / SCALE_LIMIT, SCALE_LIMIT
 
 #: Smallest disk radius, as a fraction of the box's longer side (the engine's
-#: :data:`sim.engine.core.RESOLUTION_LIMIT`, against the far edge of the disks, which the box
+#: :data:`sim.engine.inputs.RESOLUTION_LIMIT`, against the far edge of the disks, which the box
 #: side bounds): float64 positions resolve 2⁻⁵² of the side, and smaller disks' contacts
 #: drown in round-off.
 SMALLEST_RADIUS = RESOLUTION_LIMIT

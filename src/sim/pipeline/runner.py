@@ -11,7 +11,7 @@ its first checkpoint is on disk, and finds in its folder either nothing, its own
 returned as it is; cut short: resumed) or another config's run (refused, naming the keys that
 differ). Every run ends by a stop condition, its wall-clock budget, SIGINT or SIGTERM (a final
 snapshot and checkpoint, resumable), or a breakdown of the physics (recorded as the stop
-reason, :class:`sim.engine.core.PhysicsBreakdown`).
+reason, :class:`sim.engine.errors.PhysicsBreakdown`).
 """
 
 import errno
@@ -34,7 +34,8 @@ from tqdm import tqdm
 
 import sim
 from sim.analysis.observers import from_config as observers_from_config
-from sim.engine.core import Engine, PhysicsBreakdown
+from sim.engine.core import Engine
+from sim.engine.errors import PhysicsBreakdown
 from sim.pipeline import resources
 from sim.pipeline.config import ConfigError, SimConfig, flat, validate
 from sim.pipeline.run_folder import FolderBusyError, RunLock, part_path, publish

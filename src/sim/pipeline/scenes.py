@@ -16,7 +16,8 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from sim.engine.core import Boundary, Engine
+from sim.engine.core import Engine
+from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
     MELT_COLLISIONS_PER_DISK,
     RSA_JAMMING,

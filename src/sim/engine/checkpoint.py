@@ -1,0 +1,53 @@
+"""Checkpoints: every array that evolves, by name, and its restoration into an engine built
+from the same inputs, which then continues to the same bits (:class:`Checkpoints`, a part of
+:class:`sim.engine.core.Engine`)."""
+
+import math
+
+import numpy as np
+
+from sim.engine import loop
+from sim.engine.parameters import common_value
+
+
+class Checkpoints:
+    """Save and restore the evolving state (the engine's checkpointing part)."""
+
+    def state_dict(self):
+        """Every array that evolves, by name: restoring it into an engine built from the same
+        inputs continues the run to the same bits."""
+        loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
+        self.drain_event_log()
+        state = {f"disks/{name}": value for name, value in vars(self.disks).items()
+                 if value is not None}
+        state.update(counters=self.counters, accumulators=self.accumulators,
+                     pair_collisions=self.pair_collisions, wall_impulse=self.wall_impulse,
+                     initial_energy=np.array(self.initial_energy))
+        if self.virial_tensor is not None:
+            state["virial_tensor"] = self.virial_tensor
+        return state
+
+    def load_state_dict(self, state):
+        """Replace the evolving arrays by those of :meth:`state_dict` (copied). A state of
+        another scene — other arrays, or arrays of other shapes than this engine's (the
+        neighbour lists ``disks/nb`` aside, which grow) — is refused with a ValueError before
+        anything is replaced."""
+        mine = {key: np.shape(value) for key, value in self.state_dict().items()}
+        missing, unknown = sorted(set(mine) - set(state)), sorted(set(state) - set(mine))
+        if missing or unknown:
+            raise ValueError(f"the checkpoint is not one of this scene's engine: arrays "
+                             f"missing {missing}, unknown {unknown}")
+        for key, value in state.items():
+            if key != "disks/nb" and np.shape(value) != mine[key]:
+                raise ValueError(f"the checkpoint's {key} has shape {np.shape(value)}, this "
+                                 f"scene's engine {mine[key]}")
+        for key, value in state.items():
+            value = np.array(value)
+            if key.startswith("disks/"):
+                setattr(self.disks, key.removeprefix("disks/"), value)
+            elif key == "initial_energy":
+                self.initial_energy = float(value)
+            else:
+                setattr(self, key, value)
+        self._common_capacity = common_value(self.disks.nb_cap)
+        self.stall_watch[:] = (-math.inf, 0.0)  # its times ran on the clock it replaced

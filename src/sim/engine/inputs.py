@@ -1,0 +1,150 @@
+"""What the engine accepts: the box, the disks, the walls and the numbers of a scene, each
+checked before anything is built; a bad one is a ValueError whose one line names it and what
+is allowed."""
+
+import math
+import operator
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.engine.box import WALL_NAMES
+
+#: wall numbers of :mod:`sim.effects.walls` by name
+WALLS = {name: wall for wall, name in enumerate(WALL_NAMES)}
+
+#: The keys a wall's entry in ``walls`` may have.
+WALL_KEYS = ("temperature", "speed", "amplitude", "frequency")
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """Box [0, Lx] × [0, Ly]; each axis has hard walls or is periodic."""
+
+    size: tuple = (1.0, 1.0)
+    periodic: tuple = (False, False)
+
+
+def first_index(mask):
+    """Index of the first True entry of the bool array ``mask``, or None."""
+    bad = np.flatnonzero(mask)
+    return int(bad[0]) if bad.size else None
+
+
+def check_disks(position, velocity, radius, mass, species):
+    """Refuse non-finite positions and velocities (n, 2), radii and masses (n,) that are not
+    finite and > 0, and negative species, naming the first disk at fault."""
+    for name, values in (("radius", radius), ("mass", mass)):
+        bad = first_index(~((values > 0.0) & (values < math.inf)))
+        if bad is not None:
+            raise ValueError(f"disk {bad} has {name} {values[bad]}: a {name} must be finite "
+                             f"and > 0")
+    for name, values in (("position", position), ("velocity", velocity)):
+        bad = first_index(~np.isfinite(values.ravel()))
+        if bad is not None:
+            raise ValueError(f"disk {bad // 2} has {name} {values[bad // 2].tolist()}: "
+                             f"positions and velocities must be finite")
+    bad = first_index(species < 0)
+    if bad is not None:
+        raise ValueError(f"disk {bad} has species {species[bad]}: species are integers ≥ 0")
+
+
+def box_size(boundary):
+    """The box sides float64[2] of a :class:`Boundary`, refused unless finite and > 0."""
+    box = np.array(boundary.size, dtype=np.float64).reshape(-1)
+    if box.shape != (2,) or not np.all((box > 0.0) & (box < math.inf)):
+        raise ValueError(f"box size must be two finite sides > 0, got {boundary.size}")
+    return box
+
+
+def check_inside(given, position, radius, box, periodic):
+    """Refuse a disk reaching beyond a wall (R ≤ x ≤ L − R on a walled axis), naming the
+    first; ``given`` are the positions as the caller gave them, ``position`` wrapped."""
+    for axis in range(2):
+        if not periodic[axis]:
+            bad = first_index((position[:, axis] - radius < 0.0)
+                         | (position[:, axis] + radius > box[axis]))
+            if bad is not None:
+                raise ValueError(f"disk {bad} at {given[bad].tolist()} with radius "
+                                 f"{radius[bad]} pokes through a wall of the box "
+                                 f"{box.tolist()}: along a walled axis of side L a disk of "
+                                 f"radius R needs R ≤ x ≤ L − R")
+
+
+def wall_specs(walls, periodic):
+    """``walls`` as :class:`Engine` takes them (name → {key: value}), checked and keyed by
+    wall number (:mod:`sim.effects.walls`); walls without an entry stay hard and still."""
+    walls = {} if walls is None else dict(walls)
+    for name, spec in walls.items():
+        if name not in WALLS:
+            raise ValueError(f"unknown wall {name!r}: use {', '.join(WALLS)}")
+        unknown = sorted(set(spec or {}) - set(WALL_KEYS))
+        if unknown:
+            raise ValueError(f"{name} wall: unknown keys {unknown}, use {', '.join(WALL_KEYS)}")
+        if spec and periodic[WALLS[name] >> 1]:
+            raise ValueError(f"{name} wall is given on a periodic axis, which has no walls")
+    return {WALLS[name]: dict(spec) for name, spec in walls.items() if spec}
+
+
+#: float64 squares and multiplies the scales of a scene in its roots, impulses and energies:
+#: each length (box sides, radii), speed (the fastest disk, |U| + A ω of a wall, √(|g| L) of
+#: gravity, √(T_w/m) of a thermal wall) and mass must lie in [1/SCALE_LIMIT, SCALE_LIMIT], so
+#: that their squares and products keep far inside its normal range (1e-308 … 1e308).
+SCALE_LIMIT = 1e60
+
+#: The smallest radius must be at least this fraction of the far edge D of the disks (the
+#: largest x + R or y + R, the side of a periodic axis): coordinates near D are resolved to
+#: 2⁻⁵² D, and the contacts of smaller disks could not be located to 2⁻¹² of their radius.
+RESOLUTION_LIMIT = 2.0**-40
+
+
+def check_scales(box, radius, mass, velocity, extent, gravity, motion, temperature):
+    """Refuse a scene that float64 cannot hold (:data:`SCALE_LIMIT`, :data:`RESOLUTION_LIMIT`),
+    naming the parameter at fault. box (Lx, Ly), radius, mass (n,), velocity (n, 2),
+    ``extent`` the far edge of the disks; gravity, motion, temperature as :class:`Engine`
+    keeps them."""
+    def check(name, value):
+        if not 1.0 / SCALE_LIMIT <= value <= SCALE_LIMIT:
+            raise ValueError(f"{name} is {value:.3g}: it must lie in [{1.0 / SCALE_LIMIT:g}, "
+                             f"{SCALE_LIMIT:g}], as float64 squares and multiplies the lengths, "
+                             f"speeds and masses of a scene")
+
+    for axis in range(2):
+        check(f"the box side along {'xy'[axis]}", box[axis])
+    for name, values in (("radius", radius), ("mass", mass)):
+        for i in (int(np.argmin(values)), int(np.argmax(values))):
+            check(f"the {name} of disk {i}", values[i])
+    with np.errstate(over="ignore"):
+        fastest = int(np.argmax(np.einsum("ij,ij->i", velocity, velocity)))
+    speed = float(np.hypot(*velocity[fastest]))
+    # disks at rest set no speed scale, and slower ones only relative speeds, which may be tiny
+    if speed > 0.0:
+        check(f"the speed of disk {fastest}", speed)
+    if gravity is not None:
+        check("√(|g| L), the speed of a fall across the box,",
+              math.sqrt(float(np.hypot(*gravity)) * float(np.max(box))))
+    for wall in range(4):
+        if motion is not None and np.any(motion[wall, :2]):
+            check(f"the speed |U| + A ω of the {WALL_NAMES[wall]} wall",
+                  abs(motion[wall, 0]) + motion[wall, 1] * motion[wall, 2])
+        if temperature is not None and not math.isnan(temperature[wall]):
+            for m in (mass.min(), mass.max()):
+                check(f"√(T_w / m) of the {WALL_NAMES[wall]} wall for mass {m:g}",
+                      math.sqrt(temperature[wall] / m))
+    i = int(np.argmin(radius))
+    if radius[i] < RESOLUTION_LIMIT * extent:
+        raise ValueError(f"the radius of disk {i} is {radius[i]:.3g}, less than 2**-40 of the "
+                         f"far edge of the disks ({extent:.3g}; the largest x + R or y + R, the "
+                         f"side of a periodic axis): float64 coordinates there cannot resolve "
+                         f"its contacts; radii must be at least {RESOLUTION_LIMIT * extent:.3g}")
+
+
+def seed_value(seed):
+    """The thermal walls' seed as the compiled generator takes it (int64 ≥ 0)."""
+    try:
+        value = operator.index(seed)
+    except TypeError:
+        value = None
+    if value is None or not 0 <= value <= np.iinfo(np.int64).max:
+        raise ValueError(f"seed must be an integer in [0, 2**63 - 1], got {seed!r}")
+    return value

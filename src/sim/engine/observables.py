@@ -1,0 +1,149 @@
+"""What an engine reports: times, counts, positions, velocities, energies and momenta, in the
+user's numbering of the disks, and the contacts its event log kept (:class:`Observables`, a
+part of :class:`sim.engine.core.Engine`)."""
+
+import numpy as np
+
+from sim.effects.event_log import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
+from sim.effects.gravity import potential_energy
+from sim.effects.walls import wall_state
+from sim.engine import loop
+from sim.engine.kinematics import T_OWN, VX, VY, X, Y
+
+
+class Observables:
+    """Read-outs of the engine's state (the engine's observing part)."""
+
+    @property
+    def time(self):
+        """Absolute time of the last processed event."""
+        return float(self.accumulators[loop.T_ORIGIN] + self.accumulators[loop.T_NOW])
+
+    @property
+    def collisions(self):
+        return int(self.counters[loop.COLLISIONS])
+
+    @property
+    def wall_collisions(self):
+        return int(self.counters[loop.WALL_CONTACTS])
+
+    @property
+    def events(self):
+        """Disk–disk and disk–wall contacts so far."""
+        return self.collisions + self.wall_collisions
+
+    @property
+    def steps(self):
+        """Events the engine applied: contacts and neighbour-shell exits."""
+        return int(self.counters[loop.EVENTS])
+
+    @property
+    def dissipated_energy(self):
+        return float(self.accumulators[loop.DISSIPATED_DISKS]
+                     + self.accumulators[loop.DISSIPATED_WALLS])
+
+    @property
+    def virial(self):
+        """Σ r_ij·Δp_i over all disk–disk contacts so far."""
+        return float(self.accumulators[loop.VIRIAL])
+
+    def _user_order(self, values):
+        out = np.empty_like(values)
+        out[self.disks.order] = values
+        return out
+
+    def _relative_time(self, t):
+        return (self.accumulators[loop.T_NOW] if t is None
+                else float(t) - self.accumulators[loop.T_ORIGIN])
+
+    def _state(self, t):
+        return loop.state_at(self._relative_time(t), self.disks.table, self.geometry,
+                             self.grid, self.gravity)
+
+    def positions(self, t=None):
+        """Positions float64[n, 2] of every disk at absolute time ``t`` (default: the time of
+        the last event); ``t`` must not precede the last event."""
+        return self._user_order(self._state(t)[0])
+
+    def velocities(self, t=None):
+        """Velocities float64[n, 2] at absolute time ``t`` (default: the last event); they
+        change between events only under gravity."""
+        return self._user_order(self._state(t)[1])
+
+    def unwrapped_positions(self, t=None):
+        """Positions float64[n, 2] at time ``t`` continued across periodic boundaries
+        (r + windings · L), for mean squared displacements; needs ``unwrap=True``."""
+        if self.disks.images is None:
+            raise ValueError("unwrapped positions need an engine made with unwrap=True")
+        d = self.disks
+        dt = (self._relative_time(t) - d.table[:, T_OWN])[:, None]
+        acceleration = 0.0 if self.gravity is None else self.gravity
+        flown = (d.table[:, VX:VY + 1] + 0.5 * acceleration * dt) * dt
+        return self._user_order(d.table[:, X:Y + 1] + d.images * self.box + flown)
+
+    def wall_positions(self, t=None):
+        """Positions float64[4] of the walls (left, right, bottom, top) at absolute time t."""
+        t_abs = self.time if t is None else float(t)
+        return np.array([wall_state(self.wall_motion, w, t_abs, self.geometry)[0]
+                         for w in range(4)])
+
+    def collisions_by_disk(self):
+        """Contacts (disk and wall) of each disk so far: int64[n]."""
+        loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
+        return self._user_order(self.disks.contacts)
+
+    def next_event_time(self):
+        """Absolute time of the next scheduled event (possibly stale)."""
+        d = self.disks
+        return float(d.event_time.min() + self.accumulators[loop.T_ORIGIN])
+
+    def kinetic_energy_by_species(self, t=None):
+        """Σ m v²/2 per species at time t: float64[n_species]."""
+        d = self.disks
+        energy = 0.5 * d.mass * np.sum(self._state(t)[1] ** 2, axis=1)
+        return np.bincount(d.species, weights=energy, minlength=self.n_species)
+
+    def kinetic_energy(self, t=None):
+        """Σ m v²/2 at time t (default: the last event)."""
+        d = self.disks
+        return float(np.sum(0.5 * d.mass * np.sum(self._state(t)[1] ** 2, axis=1)))
+
+    def potential_energy(self, t=None):
+        """Σ −m g·r at time t (zero without gravity)."""
+        return potential_energy(self._state(t)[0], self.disks.mass, self.gravity)
+
+    @property
+    def wall_work(self):
+        """Work done on the disks by moving and thermal walls so far."""
+        return float(self.accumulators[loop.WALL_WORK])
+
+    def momentum(self, t=None):
+        d = self.disks
+        return (d.mass[:, None] * self._state(t)[1]).sum(axis=0)
+
+    def drain_event_log(self):
+        """Hand the rows of the compiled log to :attr:`event_sink` (else keep them for
+        :meth:`take_event_log`), disks renamed to the user's numbering (the engine's own
+        numbering changes when it reorders)."""
+        if self.event_log is None or self.log_fill[0] == 0:
+            return
+        rows = self.event_log[:self.log_fill[0]].copy()
+        order = self.disks.order
+        rows[:, LOG_DISK] = order[rows[:, LOG_DISK].astype(np.int64)]
+        partner = rows[:, LOG_PARTNER].astype(np.int64)
+        disk = partner >= 0
+        rows[disk, LOG_PARTNER] = order[partner[disk]]
+        self.log_fill[0] = 0
+        if self.event_sink is None:
+            self._logged.append(rows)
+        else:
+            self.event_sink(rows)
+
+    def take_event_log(self):
+        """The contacts logged since the last call: float64[k, 6], columns as in
+        :mod:`sim.effects.event_log` (disks in the user's numbering)."""
+        self.drain_event_log()
+        rows = (np.concatenate(self._logged) if self._logged
+                else np.zeros((0, LOG_COLUMNS)))
+        self._logged = []
+        return rows

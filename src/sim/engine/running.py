@@ -1,0 +1,140 @@
+"""Running the engine: the compiled loop called in chunks until a stop condition holds, the
+conditions that need Python checked between chunks, and the loop's codes turned into
+exceptions (:class:`Running`, a part of :class:`sim.engine.core.Engine`)."""
+
+import math
+import time as wallclock
+
+import numpy as np
+
+from sim.effects.walls import piston_jam
+from sim.engine import loop
+from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
+from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
+from sim.engine.kinematics import VX, VY, X, Y
+
+#: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
+#: take about this many seconds, from the rate of the chunk before, so that the budget is kept
+#: to about that; the first chunk has TIMED_FIRST_CHUNK events, none fewer than
+#: TIMED_MIN_CHUNK.
+TIMED_CHUNK_SECONDS = 0.15
+TIMED_FIRST_CHUNK = 20_000
+TIMED_MIN_CHUNK = 1_000
+
+
+class Running:
+    """Advance the engine's state in time (the engine's running part)."""
+
+    def _run_chunk(self, max_events, max_contacts, max_collisions, t_stop, dissipation_limit):
+        while True:
+            d = self.disks
+            reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
+            status, disk = loop.run_events(
+                Disks(d.table, *self._per_disk_parameters(), d.coll_count, d.contacts,
+                      d.t_last, d.streak),
+                Schedule(d.event_time, d.event_partner, d.event_count, *d.queue),
+                Neighbours(*self._list_layout(), d.nb_count, d.nb, d.cell_head, d.cell_next,
+                           d.cell_prev, d.cell_of, d.big),
+                Box(self.geometry, self.grid),
+                self._effects(),
+                Tallies(self.counters, self.accumulators, self.pair_collisions,
+                        self.wall_impulse, self.stall_watch),
+                Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
+                       dissipation_limit, self.stall_dt, self.rebase_every, self.lookahead))
+            self.drain_event_log()
+            if status == loop.STATUS_LOG_FULL:
+                continue
+            if status == loop.STATUS_EVENT_LIMIT and self.counters[loop.EVENTS] == reorder_at:
+                self.reorder()
+                if reorder_at < max_events:
+                    continue
+            if status == loop.STATUS_LIST_FULL:
+                self._grow_lists(disk)
+                continue
+            if status == loop.STATUS_STALLED:
+                self._check_piston()  # a jammed piston stalls the clock too: say so
+                raise StalledError(
+                    f"the clock has stalled at t = {self.time:.17g}: more than 16 N + 1000 "
+                    f"events in a row, each within {self.stall_dt:.3g} (float64 resolution) of "
+                    f"the one before, last for disk {d.order[disk]} at position "
+                    f"{d.table[disk, X:Y + 1].tolist()} with velocity "
+                    f"{d.table[disk, VX:VY + 1].tolist()}; the state is beyond float64 "
+                    f"resolution: for inelastic disks, and for disks resting on a wall under "
+                    f"gravity, switch on the TC model (tc.time); a chain of disks touching all "
+                    f"round a periodic box needs room between its disks")
+            if status == loop.STATUS_COLLAPSE:
+                cluster = set(np.flatnonzero(d.streak >= 2).tolist()) | {int(disk)}
+                raise InelasticCollapseError(sorted(int(d.order[k]) for k in cluster),
+                                             self.time, self.collisions)
+            return status
+
+    def run(self, *, events=None, collisions=None, time=None, energy_fraction=None,
+            wall_seconds=None, until=None, chunk_events=200_000):
+        """Advance until the first stop condition holds; returns its name.
+
+        events : disk and wall contacts since the start of the engine
+        collisions : disk–disk contacts since the start of the engine
+        time : absolute simulated time; the run stops at the last event not after it
+        energy_fraction : stop once the kinetic energy is this fraction of the initial one
+        wall_seconds : wall-clock budget of this call, checked between chunks, which are then
+            sized to take about :data:`TIMED_CHUNK_SECONDS` each (from the rate of the chunk
+            before; the first has :data:`TIMED_FIRST_CHUNK` events)
+        until : predicate ``until(engine) -> bool`` asked every ``chunk_events`` events from
+            the start of the call, whatever the chunks a wall budget makes: the same inputs
+            stop at the same event
+        chunk_events : events per compiled call (the most, with ``wall_seconds``)
+
+        The piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended
+        it. Chunk sizes change no result: the same inputs give the same bits.
+        """
+        if all(x is None for x in (events, collisions, time, energy_fraction, wall_seconds,
+                                   until)):
+            raise ValueError("run() needs at least one stop condition")
+        big = np.iinfo(np.int64).max
+        max_contacts = big if events is None else int(events)
+        max_collisions = big if collisions is None else int(collisions)
+        t_stop = math.inf if time is None else float(time)
+        closing = t_stop > self.closing_time
+        t_stop = min(t_stop, self.closing_time)
+        dissipation_limit = (math.inf if energy_fraction is None
+                             else self.initial_energy * (1.0 - float(energy_fraction)))
+        started = wallclock.perf_counter()
+        reasons = {loop.STATUS_COLLISION_LIMIT: "collisions", loop.STATUS_CONTACT_LIMIT: "events",
+                   loop.STATUS_TIME_REACHED: "time",
+                   loop.STATUS_ENERGY_REACHED: "energy_fraction",
+                   loop.STATUS_NO_EVENTS: "no_events"}
+        chunk = int(chunk_events) if wall_seconds is None else min(int(chunk_events),
+                                                                   TIMED_FIRST_CHUNK)
+        ask_at = self.steps + int(chunk_events)  # where ``until`` is asked next
+        while True:
+            chunk_started = wallclock.perf_counter()
+            steps = self.steps
+            status = self._run_chunk(min(steps + chunk, ask_at), max_contacts, max_collisions,
+                                     t_stop, dissipation_limit)
+            self._check_piston()
+            if status != loop.STATUS_EVENT_LIMIT:
+                if closing and status == loop.STATUS_TIME_REACHED:
+                    raise ClosedBoxError(
+                        f"at t = {self.closing_time:.6g} the moving walls come within the "
+                        f"largest disk diameter ({2 * self.radius.max():.6g}) of the opposite "
+                        f"wall: stop the run earlier (stop.time) or slow the piston")
+                return reasons[status]
+            if wall_seconds is not None:
+                now = wallclock.perf_counter()
+                if now - started >= wall_seconds:
+                    return "wall_seconds"
+                rate = (self.steps - steps) / max(now - chunk_started, 1e-6)
+                chunk = int(np.clip(rate * TIMED_CHUNK_SECONDS, TIMED_MIN_CHUNK, chunk_events))
+            if self.steps >= ask_at:
+                ask_at += int(chunk_events)
+                if until is not None and until(self):
+                    return "predicate"
+
+    def _check_piston(self):
+        """Raise :class:`ClosedBoxError` when a piston has jammed the disks
+        (:func:`sim.effects.walls.piston_jam`); checked after every chunk, so within one chunk
+        of the jam."""
+        jam = piston_jam(self.wall_motion, self.initial_energy, float(self.mass.sum()),
+                         self.kinetic_energy, self.time)
+        if jam is not None:
+            raise ClosedBoxError(jam)
