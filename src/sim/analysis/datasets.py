@@ -31,10 +31,10 @@ import yaml
 from xarray.backends import BackendArray
 from xarray.core import indexing
 
+from sim.storage.errors import RunFileError
 from sim.storage.h5md import OBSERVABLES
 from sim.storage.inspect import (
     DAMAGE,
-    RunFileError,
     damage_reason,
     describe,
     open_run_file,
