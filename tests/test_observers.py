@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from sim.analysis.datasets import contacts, granular_temperatures, open_run, pressure_tensor
-from sim.checks.validation import kolafa_rottner_z
+from sim.analysis.theory import kolafa_rottner_z
 from sim.figures.runs import compose_config
 from sim.pipeline.runner import run
 

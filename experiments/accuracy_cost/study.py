@@ -36,13 +36,8 @@ from scipy import stats
 
 from sim.analysis.crater import CraterGeometry
 from sim.analysis.datasets import open_run
-from sim.checks.validation import (
-    block_means,
-    enskog_collision_frequency,
-    equilibrated_gas,
-    kolafa_rottner_z,
-    virial_blocks,
-)
+from sim.analysis.theory import enskog_collision_frequency, kolafa_rottner_z
+from sim.checks.validation import block_means, equilibrated_gas, virial_blocks
 from sim.engine.core import Boundary, Engine, InelasticCollapseError
 from sim.figures.crater_runs import crater_overrides
 from sim.figures.runs import compose_config, ensure_run
