@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import sim.storage.h5md
-from sim.figures.runs import compose_config
 from sim.pipeline import runner
+from sim.pipeline.run_cache import compose_config
 from sim.storage.errors import RunFileError
 from sim.storage.inspect import summary
 

@@ -6,7 +6,7 @@ import pytest
 
 from sim.analysis.datasets import contacts, granular_temperatures, open_run, pressure_tensor
 from sim.analysis.theory import kolafa_rottner_z
-from sim.figures.runs import compose_config
+from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
 

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from sim.analysis.datasets import open_run
-from sim.figures.runs import compose_config
 from sim.pipeline import runner
 from sim.pipeline.config import ConfigError
+from sim.pipeline.run_cache import compose_config
 from sim.storage.errors import RunFileError
 from sim.storage.h5md import read_checkpoint
 from sim.storage.inspect import main, summary
