@@ -17,8 +17,8 @@ import tempfile
 import threading
 import time
 
-from sim.figures.runs import compose_config
 from sim.pipeline import runner
+from sim.pipeline.run_cache import compose_config
 from sim.storage.h5md import RunWriter
 
 

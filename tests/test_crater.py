@@ -16,8 +16,8 @@ from sim.analysis.crater import (
 )
 from sim.analysis.datasets import open_run
 from sim.engine import Engine
-from sim.figures.runs import compose_config
 from sim.pipeline.initial import hexagonal_lattice
+from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
 

@@ -23,8 +23,8 @@ import yaml
 
 import sim.storage.export
 from sim.analysis.datasets import open_run
-from sim.figures.runs import compose_config
 from sim.pipeline.command import BadInput
+from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 from sim.storage.export import export, frame_indices, hoomd_positions, main
 

@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 import sim.storage.h5md
-from sim.figures.runs import compose_config
 from sim.pipeline import runner
+from sim.pipeline.run_cache import compose_config
+from sim.storage.errors import RunFileError
 from sim.storage.inspect import summary
 
 #: a gas that runs for a few seconds, to be killed in the middle: 2000 disks, 300 snapshots;
@@ -113,7 +114,7 @@ def test_a_disk_that_fills_up_stops_the_run_before_a_write_and_keeps_the_file(
     monkeypatch.setattr(sim.storage.h5md, "free_bytes", filling_up)
     cfg = compose_config(["disks.n=500", "stop.collisions=200000",
                           "output.every_collisions=1000", "output.progress=false"])
-    with pytest.raises(runner.RunFileError, match="free some room and resume"):
+    with pytest.raises(RunFileError, match="free some room and resume"):
         runner.run(cfg, tmp_path)
     monkeypatch.undo()
     info = summary(tmp_path / "run.h5")
@@ -188,7 +189,7 @@ def test_a_failed_write_that_nothing_reported_is_said_at_exit(tmp_path):
 
 def test_a_folder_that_cannot_be_written_is_a_clear_error(tmp_path):
     cfg = compose_config(["disks.n=100", "output.progress=false"])
-    with pytest.raises(runner.RunFileError, match="cannot write the run file /proc/x/run.h5"):
+    with pytest.raises(RunFileError, match="cannot write the run file /proc/x/run.h5"):
         runner.run(cfg, "/proc/x")
     process = cli("disks.n=100", "hydra.run.dir=/proc/x", cwd=tmp_path)
     _, err = process.communicate(timeout=300)

@@ -1,5 +1,6 @@
-"""The layout: every old import path of the flat package still leads to its module, with a
-DeprecationWarning, and ``python -m`` on an old path runs the new module."""
+"""The layout: every old import path (the flat package, the run helpers once in sim.figures)
+still leads to its module, with a DeprecationWarning, and ``python -m`` on an old path runs the
+new module."""
 
 import importlib
 import subprocess

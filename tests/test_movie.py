@@ -12,7 +12,7 @@ from scipy import ndimage
 
 from sim.analysis.datasets import open_run
 from sim.figures import movie
-from sim.figures.runs import compose_config
+from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
 #: the two disks of the two_disks scene, their snapshots 0.01 apart

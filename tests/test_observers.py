@@ -4,9 +4,9 @@ back."""
 import numpy as np
 import pytest
 
-from sim.analysis.datasets import contacts, open_run, pressure_tensor
-from sim.checks.validation import kolafa_rottner_z
-from sim.figures.runs import compose_config
+from sim.analysis.datasets import contacts, granular_temperatures, open_run, pressure_tensor
+from sim.analysis.theory import kolafa_rottner_z
+from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
 
@@ -47,8 +47,10 @@ def test_clusters_of_a_solid_and_of_a_dilute_gas(overrides, largest, tmp_path):
 
 
 def test_local_fields_add_up_to_the_whole_gas(tmp_path):
-    """The packing fractions of the cells average to the gas's φ exactly, and the cells' heat
-    adds up to the kinetic energy less the cells' flow, about one disk's share per cell."""
+    """The packing fractions of the cells average to the gas's φ exactly; the temperature of
+    a cell (row = y cell, column = x cell) is Σ m |v − u|² / (2 (N_c − 1)) of its disks, and
+    the cells' heat adds up to the kinetic energy less the cells' flow, about one disk's share
+    per cell; pooled over the cells it is the temperature of granular_temperatures."""
     cfg = compose_config(["disks.packing_fraction=0.3", "observe.local_fields.cells=8",
                           "stop.collisions=20000", "output.every_collisions=10000",
                           "output.progress=false"])
@@ -58,12 +60,23 @@ def test_local_fields_add_up_to_the_whole_gas(tmp_path):
         assert fields["field"].values.tolist() == ["packing_fraction", "temperature"]
         n = ds.sizes["disk"]
         position = ds["position"].isel(time=-1).values
+        velocity = ds["velocity"].isel(time=-1).values
+        mass = ds["mass"].values
         energy = float(ds["kinetic_energy"].values[-1])
         packing, temperature = fields.isel(time=-1).values
     assert packing.mean() == pytest.approx(0.3, rel=1e-12)
     counts = np.histogram2d(position[:, 1], position[:, 0], bins=8, range=[[0, 1], [0, 1]])[0]
-    heat = np.nansum(counts * temperature)
+    iy, ix = np.unravel_index(np.argmax(counts), counts.shape)
+    inside = (np.floor(position[:, 1] * 8) == iy) & (np.floor(position[:, 0] * 8) == ix)
+    m, v = mass[inside], velocity[inside]
+    u = m @ v / m.sum()
+    assert temperature[iy, ix] == pytest.approx(
+        np.sum(m * np.sum((v - u) ** 2, axis=1)) / (2.0 * (inside.sum() - 1)), rel=1e-12)
+    heat = np.nansum((counts - 1.0) * temperature)
     assert energy * (1.0 - 2.0 * 64 / n) < heat < energy
+    pooled = granular_temperatures(position[None], velocity[None], mass, np.zeros(n, int),
+                                   (1.0, 1.0))[0, 0]
+    assert pooled == pytest.approx(heat / np.sum(counts[counts > 1] - 1.0), rel=1e-12)
 
 
 def periodic_gas(tmp_path, *overrides):

@@ -16,7 +16,8 @@ from sim.analysis.datasets import open_run, open_sweep
 from sim.pipeline import runner
 from sim.pipeline.cli import CONF_DIR
 from sim.pipeline.config import ConfigError, register
-from sim.storage.inspect import RunFileError, summary
+from sim.storage.errors import RunFileError
+from sim.storage.inspect import summary
 
 register()
 SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))

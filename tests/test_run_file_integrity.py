@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from sim.analysis.datasets import open_run
-from sim.figures.runs import compose_config
 from sim.pipeline import runner
 from sim.pipeline.config import ConfigError
+from sim.pipeline.run_cache import compose_config
+from sim.storage.errors import RunFileError
 from sim.storage.h5md import read_checkpoint
-from sim.storage.inspect import RunFileError, main, summary
+from sim.storage.inspect import main, summary
 
 #: 300 disks, 17 snapshots, checkpoints at the first snapshot (slot a) and the last (slot b)
 RUN = ["disks.n=300", "stop.collisions=4000", "output.every_collisions=250",
@@ -246,3 +247,11 @@ def test_a_file_open_for_writing_in_another_process_is_named_so(intact, tmp_path
             assert capsys.readouterr().err == f"sim-inspect: {message}\n"
         finally:
             holder.kill()
+
+
+def test_one_error_for_a_run_file_that_cannot_be_read_or_written():
+    """The reader's and the runner's errors are one class, an OSError, under its old names."""
+    import sim.storage.inspect
+
+    assert sim.storage.inspect.RunFileError is runner.RunFileError is RunFileError
+    assert issubclass(RunFileError, OSError)

@@ -34,18 +34,11 @@ from matplotlib import pyplot as plt
 from matplotlib.ticker import NullFormatter
 from scipy import stats
 
-from sim.analysis.crater import CraterGeometry
+from sim.analysis.crater import CraterGeometry, crater_overrides
 from sim.analysis.datasets import open_run
-from sim.checks.validation import (
-    block_means,
-    enskog_collision_frequency,
-    equilibrated_gas,
-    kolafa_rottner_z,
-    virial_blocks,
-)
+from sim.analysis.theory import enskog_collision_frequency, kolafa_rottner_z
+from sim.checks.validation import block_means, equilibrated_gas, virial_blocks
 from sim.engine import Boundary, Engine, InelasticCollapseError
-from sim.figures.crater_runs import crater_overrides
-from sim.figures.runs import compose_config, ensure_run
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,
@@ -54,6 +47,7 @@ from sim.pipeline.initial import (
     random_sequential,
     remove_drift,
 )
+from sim.pipeline.run_cache import compose_config, ensure_run
 from sim.pipeline.runner import run
 
 

@@ -1,6 +1,7 @@
-"""Import paths of the flat layout before 0.2, kept for one release: ``import sim.runner``
-still gives :mod:`sim.pipeline.runner`, with a DeprecationWarning, and ``python -m sim.inspect``
-still runs :mod:`sim.storage.inspect`."""
+"""Import paths of the flat layout before 0.2, and of the run cache and crater runs once in
+:mod:`sim.figures`, kept for one release: ``import sim.runner`` still gives
+:mod:`sim.pipeline.runner`, with a DeprecationWarning, and ``python -m sim.inspect`` still runs
+:mod:`sim.storage.inspect`."""
 
 import sys
 import warnings
@@ -23,7 +24,8 @@ MOVED = {
     "sim.observers": "sim.analysis.observers", "sim.theory": "sim.analysis.theory",
     "sim.crater": "sim.analysis.crater", "sim.validation": "sim.checks.validation",
     "sim.reference": "sim.checks.reference", "sim.audit": "sim.checks.audit",
-    "sim.movie": "sim.figures.movie",
+    "sim.movie": "sim.figures.movie", "sim.figures.runs": "sim.pipeline.run_cache",
+    "sim.figures.crater_runs": "sim.analysis.crater",
 }
 
 

@@ -1,5 +1,6 @@
 """From run files to numbers: xarray datasets of runs and sweeps (:mod:`sim.analysis.datasets`),
-the observers computed at snapshots, the closed forms of the theory, and the crater measure.
+the observers computed at snapshots, the grid of cells and its granular temperature, the closed
+forms of the theory, and the crater measure.
 
 ``open_run``, ``open_sweep`` and the other readers of :mod:`sim.analysis.datasets` are
 importable from here.

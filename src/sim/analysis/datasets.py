@@ -31,10 +31,11 @@ import yaml
 from xarray.backends import BackendArray
 from xarray.core import indexing
 
+from sim.analysis.cells import cell_index, granular_temperature, grid
+from sim.storage.errors import RunFileError
 from sim.storage.h5md import OBSERVABLES
 from sim.storage.inspect import (
     DAMAGE,
-    RunFileError,
     damage_reason,
     describe,
     open_run_file,
@@ -252,35 +253,23 @@ def open_sweep(multirun_dir):
 
 
 def granular_temperatures(position, velocity, mass, species, box, cells=8):
-    """Temperature of each species in the frame of the local flow: velocities minus the
-    mass-weighted mean velocity u of their cell on a ``cells`` × ``cells`` grid, then
-    T_s = Σ_s m (v − u)²/2 / Σ_s (1 − m/M), sums over the disks of species s, M the mass of
-    a disk's cell (2D, k_B = 1). A cooling gas grows shear and clustering modes; their
-    collective motion is flow, not temperature. Subtracting u takes from each disk, on
-    average, the share m/M of its kinetic energy (at equilibrium ⟨m (v − u)²⟩/2 = T (1 − m/M)),
-    most from the heaviest: the denominator makes the estimate unbiased (N − 1 for N equal
-    disks), where the plain mean would put T₂/T₁ 2 % low for masses 1 and 4, 8 × 8 cells and
-    4000 disks.
+    """Temperature of each species in the frame of the local flow: the disks' velocities less
+    the mass-weighted mean velocity of their cell on the grid of :func:`sim.analysis.cells.grid`
+    (``cells`` along x), pooled by species (:func:`sim.analysis.cells.granular_temperature`:
+    T_s = Σ_s m |v − u|² / (2 Σ_s (1 − m/M)), 2D, k_B = 1).
 
     ``position``, ``velocity``: float64[T, N, 2]; ``mass``, ``species``: [N].
     Returns float64[T, n_species].
     """
     position, velocity = np.asarray(position), np.asarray(velocity)
+    mass, species = np.asarray(mass, dtype=np.float64), np.asarray(species)
     n_species = int(species.max()) + 1
-    ix = np.clip((position[..., 0] / box[0] * cells).astype(int), 0, cells - 1)
-    iy = np.clip((position[..., 1] / box[1] * cells).astype(int), 0, cells - 1)
-    cell = ix * cells + iy
+    shape = grid(box, cells)
+    cell = cell_index(position, box, shape)
     out = np.empty((position.shape[0], n_species))
     for t in range(position.shape[0]):
-        weight = np.bincount(cell[t], weights=mass, minlength=cells * cells)
-        flow = np.stack([np.bincount(cell[t], weights=mass * velocity[t, :, a],
-                                     minlength=cells * cells) for a in range(2)], axis=1)
-        flow /= np.maximum(weight, 1e-300)[:, None]
-        peculiar = velocity[t] - flow[cell[t]]
-        energy = 0.5 * mass * np.sum(peculiar**2, axis=1)
-        kept = 1.0 - mass / weight[cell[t]]
-        out[t] = (np.bincount(species, weights=energy, minlength=n_species)
-                  / np.bincount(species, weights=kept, minlength=n_species))
+        out[t] = granular_temperature(velocity[t], mass, cell[t], shape[0] * shape[1], species,
+                                      n_species)
     return out
 
 

@@ -16,6 +16,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from sim.analysis.cells import cell_index, granular_temperature, grid
 from sim.checks.audit import kd_tree
 from sim.pipeline.config import ConfigError
 
@@ -96,11 +97,11 @@ class Clusters:
 
 
 class LocalFields:
-    """Packing fraction and granular temperature on a grid of ``cells`` × ``cells_y`` cells: a
-    disk counts in the cell of its centre; the packing fraction is Σ πR² over the cell's area,
-    the temperature ⟨m |v − u|²⟩/2 over its disks in the frame of the cell's mass-weighted
-    mean velocity u (2D, k_B = 1; the collective flow of a cooling gas is not heat). Empty
-    cells hold NaN temperature. Value [2, y, x]: packing fraction, then temperature."""
+    """Packing fraction and granular temperature on the grid of :func:`sim.analysis.cells.grid`
+    (``cells`` along x): a disk counts in the cell of its centre; the packing fraction is
+    Σ πR² over the cell's area, the temperature that of the cell's disks in the frame of their
+    mass-weighted mean velocity (:func:`sim.analysis.cells.granular_temperature`), NaN for a
+    cell of fewer than two disks. Value [2, y, x]: packing fraction, then temperature."""
 
     name = "local_fields"
     unit = "1 (packing fraction), energy (temperature)"
@@ -108,36 +109,25 @@ class LocalFields:
     dims = ("field", "y", "x")
 
     def __init__(self, cells, engine):
-        lx, ly = (float(side) for side in engine.box)
-        self.cells = (cells, max(1, round(cells * ly / lx)))
-        self.width = (lx / self.cells[0], ly / self.cells[1])
-        self.shape = (2, self.cells[1], self.cells[0])
+        self.box = tuple(float(side) for side in engine.box)
+        self.grid = grid(self.box, cells)
+        ny, nx = self.grid
+        width = (self.box[0] / nx, self.box[1] / ny)
+        self.cell_area = width[0] * width[1]
+        self.shape = (2, ny, nx)
         self.coords = {"field": np.array([b"packing_fraction", b"temperature"]),
-                       "x": (np.arange(self.cells[0]) + 0.5) * self.width[0],
-                       "y": (np.arange(self.cells[1]) + 0.5) * self.width[1]}
+                       "x": (np.arange(nx) + 0.5) * width[0],
+                       "y": (np.arange(ny) + 0.5) * width[1]}
         self.description = ("packing fraction and granular temperature (./field) on "
-                            f"{self.cells[0]} × {self.cells[1]} cells; cell centres in ./x, ./y")
+                            f"{nx} × {ny} cells; cell centres in ./x, ./y")
         self.disk_area = np.pi * np.asarray(engine.radius, dtype=np.float64) ** 2
         self.mass = np.asarray(engine.mass, dtype=np.float64)
 
     def __call__(self, engine, t, position, velocity):
-        nx, ny = self.cells
-        ix = np.clip((position[:, 0] / self.width[0]).astype(int), 0, nx - 1)
-        iy = np.clip((position[:, 1] / self.width[1]).astype(int), 0, ny - 1)
-        cell = iy * nx + ix
-        m, v = self.mass, velocity
-
-        def per_cell(weights):
-            return np.bincount(cell, weights=weights, minlength=nx * ny)
-
-        packing = per_cell(self.disk_area) / (self.width[0] * self.width[1])
-        mass = per_cell(m)
-        flow = np.stack([per_cell(m * v[:, a]) for a in range(2)], axis=1)
-        flow /= np.where(mass > 0.0, mass, 1.0)[:, None]
-        peculiar = 0.5 * m * np.sum((v - flow[cell]) ** 2, axis=1)
-        count = per_cell(np.ones_like(m))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            temperature = per_cell(peculiar) / count
+        cell = cell_index(position, self.box, self.grid)
+        n_cells = self.grid[0] * self.grid[1]
+        packing = np.bincount(cell, weights=self.disk_area, minlength=n_cells) / self.cell_area
+        temperature = granular_temperature(velocity, self.mass, cell, n_cells)
         return np.stack([packing, temperature]).reshape(self.shape)
 
 

@@ -4,7 +4,8 @@ A row (:class:`Check`) holds the measured value, the reference and its source, t
 the comparison allows and why, whether it passed, and the wall-clock seconds of its run.
 ``tests/test_validation.py`` runs every study as a slow test and writes the table to
 ``outputs/validation/`` (``make validate``). Each study's docstring gives its formula and source;
-for the dense fluid the equation of state of Kolafa & Rottner, Mol. Phys. 104, 3435 (2006).
+the closed forms it compares with (equations of state, Enskog's collision frequency, the
+mixture's temperature ratio) are those of :mod:`sim.analysis.theory`.
 
 Units: k_B = 1, unit masses unless stated, 2D temperature T = E_kin/(N − 1) when the total
 momentum is zero (E_kin = (N − 1) T: two degrees of freedom per disk, two fixed by the
@@ -20,7 +21,12 @@ from scipy import stats
 from scipy.optimize import brentq
 
 from sim.analysis.datasets import granular_temperatures
-from sim.analysis.theory import garzo_dufty_temperature_ratio
+from sim.analysis.theory import (
+    enskog_collision_frequency,
+    garzo_dufty_temperature_ratio,
+    henderson_z,
+    kolafa_rottner_z,
+)
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
@@ -50,31 +56,6 @@ class Check:
 
 
 # -- equilibrium hard-disk fluid --------------------------------------------------------------
-
-#: Kolafa & Rottner (2006), Eq. (7) with the fit up to ρσ² = 0.90 (φ ≤ 0.707): Z = Σ A_i x^i,
-#: x = φ/(1 − φ), as {i: A_i}. It passes within about one error bar through their molecular
-#: dynamics data (relative errors 2e-6 … 1e-5) and expands to the exact B₃ and the known B₄.
-KOLAFA_ROTTNER = {0: 1.0, 1: 2.0, 2: 1.12801775, 3: 0.00181895291, 4: -0.0526134737,
-                  5: 0.0504960168, 6: -0.0325537792, 7: 0.0134578632, 8: 0.00140888182,
-                  9: -0.00834273601, 10: 0.00694127367, 11: -0.00262254723,
-                  12: 0.000355746352, 22: -5.24672938e-9, 57: 5.88054639e-23}
-
-
-def henderson_z(phi):
-    """Henderson, Mol. Phys. 30, 971 (1975): Z = (1 + φ²/8)/(1 − φ)²."""
-    return (1.0 + phi * phi / 8.0) / (1.0 - phi) ** 2
-
-
-def kolafa_rottner_z(phi):
-    """Compressibility factor of the hard-disk fluid, Kolafa & Rottner (2006) fit."""
-    x = phi / (1.0 - phi)
-    return sum(a * x**i for i, a in KOLAFA_ROTTNER.items())
-
-
-def enskog_collision_frequency(n_density, sigma, chi, temperature, mass=1.0):
-    """Collisions per disk per unit time, ω = 2 n σ χ √(πT/m) (physics.md)."""
-    return 2.0 * n_density * sigma * chi * math.sqrt(math.pi * temperature / mass)
-
 
 def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None):
     """Elastic equal-size disks in the periodic unit box at T = 1 with zero total momentum,

@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 from sim.figures import STAGES
-from sim.figures.runs import ensure_run, ensure_sweep
 from sim.figures.style import QUICK_FOLDER
+from sim.pipeline.run_cache import ensure_run, ensure_sweep
 
 
 def main(argv=None):

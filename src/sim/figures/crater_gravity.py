@@ -26,9 +26,8 @@ import yaml
 from matplotlib.ticker import NullFormatter
 from scipy import stats
 
-from sim.analysis.crater import calibrated_spacing, crater_area
+from sim.analysis.crater import calibrated_spacing, crater_area, preparation_of, require_stop
 from sim.analysis.datasets import open_sweep
-from sim.figures.crater_runs import preparation_of, require_stop
 from sim.figures.style import figure, save
 
 NAME = "fig11_crater_gravity"

@@ -12,9 +12,8 @@ start (gaps between resting disks) and at the end.
 
 import numpy as np
 
-from sim.analysis.crater import CraterGeometry, crater_area
+from sim.analysis.crater import CraterGeometry, crater_area, crater_overrides, preparation_of
 from sim.analysis.datasets import open_run
-from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import draw_disks, figure, save
 
 NAME = "fig08_crater_grid"

@@ -26,9 +26,8 @@ of floor-limited beds, the local exponent to the next radius, and the fit.
 import numpy as np
 from scipy import stats
 
-from sim.analysis.crater import CraterGeometry
+from sim.analysis.crater import CraterGeometry, crater_overrides, preparation_of
 from sim.analysis.datasets import at_last_snapshot, open_sweep
-from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import figure, save
 
 NAME = "fig09_crater_radius"

@@ -23,9 +23,8 @@ resting disks).
 
 import numpy as np
 
-from sim.analysis.crater import CraterGeometry
+from sim.analysis.crater import CraterGeometry, crater_overrides, preparation_of
 from sim.analysis.datasets import open_sweep
-from sim.figures.crater_runs import crater_overrides, preparation_of
 from sim.figures.style import figure, save
 
 NAME = "fig10_crater_speed"

@@ -5,14 +5,19 @@ round-off)."""
 import numpy as np
 
 from sim.analysis.datasets import open_run
-from sim.figures.gas_runs import gas_overrides
 from sim.figures.style import draw_disks, figure, save
 
 NAME = "fig04_gas_snapshot"
 
 
 def runs(quick):
-    return {"gas": gas_overrides(quick)[1]}
+    """The gas run that figures 4 and 5 share: N disks started at equal speeds (the seed
+    study's 10 000; quick 1000), sampled every N/10 collisions for 3N + 200 000 collisions
+    (quick 3N + 20 000)."""
+    n = 1000 if quick else 10_000
+    collisions = 3 * n + (20_000 if quick else 200_000)
+    return {"gas": ["scenario=gas", f"disks.n={n}", f"stop.collisions={collisions}",
+                    f"output.every_collisions={n // 10}"]}
 
 
 def draw(runs, sweeps, out_dir):

@@ -12,14 +12,13 @@ import numpy as np
 from scipy import stats
 
 from sim.analysis.datasets import open_run
-from sim.figures.gas_runs import gas_overrides
+from sim.figures import gas_snapshot
 from sim.figures.style import figure, save
 
 NAME = "fig05_maxwell_boltzmann"
 
-
-def runs(quick):
-    return {"gas": gas_overrides(quick)[1]}
+#: the gas run of figure 4
+runs = gas_snapshot.runs
 
 
 def equilibration_index(mean_speed, tail=0.5, width=4.0):

@@ -55,7 +55,7 @@ from sim.effects.gravity import gravity_vector
 from sim.effects.walls import wall_motion, wall_state
 from sim.engine.box import WALL_NAMES
 from sim.pipeline.command import BadInput, CannotWrite, Parser, run_command
-from sim.storage.inspect import RunFileError
+from sim.storage.errors import RunFileError
 
 #: contacts per disk per snapshot interval above which frames between snapshots get a note
 MISSED_CONTACTS = 0.1
@@ -528,8 +528,8 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
     """Write the movie of the run file ``run_path`` (the command's options as arguments) and
     return its path: ``out``, or the same name with .gif when ffmpeg is unavailable. Notes (a
     GIF instead of an MP4, frames drawn across contacts) go to ``note``, one line each.
-    BadInput or :class:`sim.storage.inspect.RunFileError` for bad input, OSError when the movie
-    cannot be written."""
+    BadInput or :class:`sim.storage.errors.RunFileError` for bad input, another OSError when the
+    movie cannot be written."""
     if color not in COLORINGS:
         raise BadInput(f"--color {color}: one of {', '.join(COLORINGS)}")
     out = _output(run_path, out)
@@ -591,6 +591,8 @@ def main(argv=None):
             out = make_movie(args.run, args.out, args.fps, args.frames, args.duration,
                              args.color, args.start, args.stop,
                              note=lambda line: print(line, file=sys.stderr, flush=True))
+        except RunFileError:  # the run file read, not the movie written: bad input
+            raise
         except OSError as error:
             reason = str(error).strip().splitlines()[0] if str(error).strip() else repr(error)
             raise CannotWrite(f"the movie could not be written: {reason}") from error

@@ -11,7 +11,7 @@ frame (quick 2 %) before it hits. Cooling: frames 0.4 apart until t = 100, long 
 clusters to grow (quick: 1000 disks until t = 40, a box too small for clusters to last).
 """
 
-from sim.figures.crater_runs import crater_overrides
+from sim.analysis.crater import crater_overrides
 from sim.figures.movie import make_movie
 
 NAME = "movies"

@@ -46,7 +46,6 @@ from sim.pipeline.run_folder import FolderBusyError, RunLock, new_folder
 from sim.pipeline.runner import (
     COSMETIC,
     Interruption,
-    RunFileError,
     describe_differences,
     differences,
     resumable,
@@ -54,6 +53,7 @@ from sim.pipeline.runner import (
     run,
     stored_config,
 )
+from sim.storage.errors import RunFileError
 from sim.storage.h5md import hdf5_reason
 from sim.storage.inspect import summary
 

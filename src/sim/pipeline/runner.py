@@ -41,8 +41,8 @@ from sim.pipeline.config import ConfigError, SimConfig, flat, validate
 from sim.pipeline.run_folder import FolderBusyError, RunLock, part_path, publish
 from sim.pipeline.scenes import build_scene, preparation
 from sim.pipeline.stop_conditions import already_met, at_rest, check_reachable
+from sim.storage.errors import RunFileError
 from sim.storage.h5md import DiskFullError, RunWriter, hdf5_reason, read_checkpoint
-from sim.storage.inspect import RunFileError as UnreadableRunFile
 from sim.storage.inspect import open_run_file
 
 log = logging.getLogger(__name__)
@@ -58,10 +58,6 @@ RESUMABLE = ("stop.collisions", "stop.events", "stop.time", "stop.energy_fractio
 #: Keys in which a run asked for again into its own folder may differ from the run there:
 #: neither changes what is simulated or written.
 COSMETIC = ("stop.wall_seconds", "output.progress")
-
-
-class RunFileError(OSError):
-    """The run file cannot be created or written (read-only folder, full disk)."""
 
 
 def _cannot_write(path, error, then=""):
@@ -353,7 +349,7 @@ def stored_config(path, key="resume"):
             attrs = f["parameters"].attrs
             text, reason = str(attrs["config"]), str(attrs["stop_reason"])
         stored = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(text))
-    except UnreadableRunFile as error:
+    except RunFileError as error:
         raise ConfigError(key, str(path), f"a readable run file: {error}") from error
     except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
         raise ConfigError(key, str(path), f"a run file with its config intact: "
@@ -375,7 +371,7 @@ def _check_consistent(path, cfg, key="resume"):
             root = f.get("checkpoint")
             if root is not None and "latest" in root.attrs:
                 found["checkpointed disks"] = root[root.attrs["latest"]]["disks/table"].shape[0]
-    except (UnreadableRunFile, KeyError, OSError, RuntimeError) as error:
+    except (KeyError, OSError, RuntimeError) as error:  # RunFileError is an OSError
         raise ConfigError(key, str(path), f"a readable run file: "
                           f"{' '.join(str(error).split())}") from error
     wanted = {"disks": n, "box": [float(x) for x in cfg.box.size],
@@ -561,7 +557,7 @@ def _resume_locked(path, stored, reason, overrides, started):
         with h5py.File(path, "r") as f:
             state, last_time, snapshots, slot = read_checkpoint(f)
         engine.load_state_dict(state)
-    except UnreadableRunFile as error:  # both checkpoints damaged
+    except RunFileError as error:  # both checkpoints damaged
         raise ConfigError("resume", str(path), "a run file with an intact checkpoint; "
                           + str(error).partition(": ")[2]) from error
     except (ValueError, KeyError, OSError) as error:

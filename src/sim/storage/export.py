@@ -44,7 +44,7 @@ import numpy as np
 
 from sim.analysis.datasets import open_run
 from sim.pipeline.command import BadInput, CannotWrite, Parser, run_command
-from sim.storage.inspect import RunFileError
+from sim.storage.errors import RunFileError
 
 #: the columns of every disk's line in an xyz file
 XYZ_PROPERTIES = "type:I:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1"
@@ -170,7 +170,7 @@ def export(run_path, fmt, out=None, frames=None):
     """Export the run file ``run_path`` as ``fmt`` (``gsd`` or ``xyz``) to ``out`` (default:
     beside the run file, its suffix replaced), the snapshots ``frames`` selects
     (:func:`frame_indices`). Returns the path written; :class:`BadInput` or
-    :class:`sim.storage.inspect.RunFileError` when it cannot be, and then nothing is left behind."""
+    :class:`sim.storage.errors.RunFileError` when it cannot be, and then nothing is left behind."""
     if fmt not in WRITERS:
         raise BadInput(f"unknown format {fmt!r}: {' or '.join(WRITERS)}")
     target = Path(out) if out is not None else Path(run_path).with_suffix(f".{fmt}")

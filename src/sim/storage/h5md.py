@@ -45,7 +45,8 @@ import yaml
 
 import sim
 from sim.effects.event_log import LOG_COLUMNS, LOG_CONTACT
-from sim.storage.inspect import DAMAGE, RunFileError
+from sim.storage.errors import RunFileError
+from sim.storage.inspect import DAMAGE
 
 OBSERVABLES = {
     "kinetic_energy": ("energy", "Σ m v²/2 over all disks"),
@@ -416,7 +417,7 @@ def _slot_state(group):
 def read_checkpoint(file):
     """The engine state of the latest complete checkpoint, its time, its snapshot count and
     its slot. When that slot is damaged, the other slot's older checkpoint, with a
-    RuntimeWarning; :class:`sim.storage.inspect.RunFileError` when no complete checkpoint is
+    RuntimeWarning; :class:`sim.storage.errors.RunFileError` when no complete checkpoint is
     intact."""
     root = file["checkpoint"]
     latest = str(root.attrs["latest"])

@@ -20,10 +20,7 @@ import h5py
 import numpy as np
 import yaml
 
-
-class RunFileError(ValueError):
-    """Not a readable sim run file."""
-
+from sim.storage.errors import RunFileError
 
 #: what a read of a damaged run file raises: h5py's errors, and HDF5's for broken metadata
 DAMAGE = (KeyError, OSError, RuntimeError, ValueError)

@@ -1,4 +1,4 @@
-"""Runs and sweeps for the figure stages, each made once per resolved config.
+"""Runs and sweeps made once per resolved config, for the figure stages and the experiments.
 
 A run lives in ``<root>/<label>-<hash>/run.h5``, the hash taken over its resolved config and
 how its scene is prepared (:func:`sim.pipeline.scenes.preparation`: a placement that changes under
@@ -25,6 +25,7 @@ register()
 
 
 def compose_config(overrides):
+    """The config of ``overrides`` as ``python -m sim`` composes it from ``conf/``."""
     with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
         return compose("config", overrides=list(overrides))
 
