@@ -5,7 +5,8 @@ random cyclic order, so that each load must wait for the one before it and no pr
 guess the next address: the time per load is the latency of the level the buffer fits in
 (L1, L2, L3, memory). The event engine's state is about 290 bytes per disk, so N disks need
 about 0.3 N kB; beyond the last cache level each access to a disk the loop has not asked for
-in advance (``sim.engine.loop.prefetch_upcoming``) costs the time printed for the largest sizes.
+in advance (``sim.engine.lookahead.prefetch_upcoming``) costs the time printed for the largest
+sizes.
 
     python benchmarks/memory_latency.py
     python benchmarks/memory_latency.py --mib 1 8 64 512 --json

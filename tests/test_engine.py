@@ -9,8 +9,8 @@ import pytest
 from conftest import assert_no_overlap, gas
 from sim.checks.audit import overlapping_pairs
 from sim.engine import Boundary, Engine, InelasticCollapseError
+from sim.engine.codes import SHELL_EXITS, STALE_EVENTS
 from sim.engine.kinematics import DISK_COLUMNS, VX, VY, X, Y
-from sim.engine.loop import SHELL_EXITS, STALE_EVENTS
 from sim.engine.neighbours import shell_centre
 from sim.engine.sizing import LIST_GROWTH, packing_fraction_around_disks, shell_ratio
 from sim.pipeline.initial import PlacementError, hexagonal_lattice, random_sequential

@@ -864,7 +864,7 @@ def test_inelastic_collapse_is_exit_3_with_the_state_kept(tmp_path):
 
 def test_a_jammed_piston_is_exit_3_with_the_state_kept(tmp_path):
     result = sim("disks.n=50", "disks.packing_fraction=0.05", "walls.top.speed=-0.5",
-                 "stop.collisions=null", "stop.wall_seconds=60",
+                 "stop.collisions=null", "stop.wall_seconds=3600",
                  "output.every_collisions=100000", "hydra.run.dir=run", cwd=tmp_path)
     check(result, 3, ["jammed"])
     info = summary(tmp_path / "run" / "run.h5")

@@ -1,21 +1,16 @@
-"""What happens at contact: smooth hard disks with normal restitution.
+"""The impulse of a contact between two smooth hard disks.
 
-Disk–disk (Brilliantov & Pöschel, *Kinetic Theory of Granular Gases*, §1; physics.md):
-with unit normal n = r_ij/|r_ij|, normal relative speed v_n = (v_i - v_j)·n < 0 and reduced mass
-μ = m_i m_j/(m_i + m_j), the impulse on i is Δp_i = -(1 + ξ) μ v_n n = -Δp_j. Momentum is
-conserved and the kinetic energy falls by exactly (1 - ξ²) μ v_n²/2. The collision virial
-r_ij·Δp_i = -(1 + ξ) μ v_n |r_ij| enters the pressure.
-
-Wall: v_n' = -ξ_w v_n, v_t' = v_t, in the frame of the wall (:mod:`sim.effects.walls`); the energy
-lost is (1 - ξ_w²) m v_n²/2.
-
-TC model (Luding & McNamara, Granular Matter 1, 113 (1998)): a contact is elastic when either
-partner touched anything — disk or wall — less than ``t_c`` ago. Wall contacts count, so a
-disk trapped between a wall and its neighbours cannot collapse against the wall either.
+With unit normal n = r_ij/|r_ij|, normal relative speed v_n = (v_i - v_j)·n < 0, reduced mass
+μ = m_i m_j/(m_i + m_j) and normal restitution ξ (1 when elastic;
+:mod:`sim.effects.restitution`), the impulse on i is Δp_i = -(1 + ξ) μ v_n n = -Δp_j
+(Brilliantov & Pöschel, *Kinetic Theory of Granular Gases*, §1). Momentum is conserved and
+the kinetic energy falls by exactly (1 - ξ²) μ v_n²/2. The collision virial
+r_ij·Δp_i = -(1 + ξ) μ v_n |r_ij| enters the pressure. A wall contact is the rule of
+:mod:`sim.effects.walls`.
 
 :func:`collide_disks` returns ``(dissipated energy, virial term)`` and updates velocities in
-place in the disk table ``disks`` (columns in :mod:`sim.engine.kinematics`); masses are passed as
-values.
+place in the disk table ``disks`` (columns in :mod:`sim.engine.kinematics`); masses are passed
+as values.
 """
 
 import math

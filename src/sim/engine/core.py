@@ -22,7 +22,7 @@ from sim.effects.restitution import CollapseWatch, restitution_matrix, wall_rest
 from sim.effects.tc import tc_time
 from sim.effects.thermal_walls import wall_temperature
 from sim.effects.walls import closing_time, wall_motion
-from sim.engine import loop
+from sim.engine import codes
 from sim.engine.checkpoint import Checkpoints
 from sim.engine.inputs import (
     Boundary,
@@ -154,8 +154,8 @@ class Engine(Running, Observables, Checkpoints):
         self.radius = radius
         self.mass = mass
         self.species = species
-        self.counters = np.zeros(loop.N_COUNTERS, dtype=np.int64)
-        self.accumulators = np.zeros(loop.N_ACCUMULATORS)
+        self.counters = np.zeros(codes.N_COUNTERS, dtype=np.int64)
+        self.accumulators = np.zeros(codes.N_ACCUMULATORS)
         self.pair_collisions = np.zeros((self.n_species, self.n_species), dtype=np.int64)
         self.wall_impulse = np.zeros(4)
         self.virial_tensor = np.zeros(3) if pressure_tensor else None
@@ -264,11 +264,11 @@ class Engine(Running, Observables, Checkpoints):
         # are then predicted in the first run, in this queue, until the clock's first rebase
         # sizes it anew.
         d.event_time[:] = 0.0
-        d.event_partner[:] = loop.UNPREDICTED
+        d.event_partner[:] = codes.UNPREDICTED
         build_queue(*d.queue, d.event_time, 0.0)
         d.block_rate[0] = n / (BLOCK_EVENTS * first_event)
         self._run_chunk(0, 0, 0, 0.0, np.inf)
-        if not np.any(d.event_partner == loop.UNPREDICTED):
+        if not np.any(d.event_partner == codes.UNPREDICTED):
             build_queue(*d.queue, d.event_time, 0.0)
         self.stall_watch[:] = (-math.inf, 0.0)  # the first predictions, all at t = 0, are no run
         if n >= REORDER_MIN_DISKS:

@@ -18,9 +18,8 @@ it asks the CPU to prefetch the partner's data and that of the next disks in the
 states larger than the caches several events ahead (:func:`prefetch_upcoming`,
 :mod:`sim.engine.prefetch`).
 
-Words: a *contact* is a disk touching a disk (a *collision*) or a wall (a *wall contact*); an
-*event* is what the loop applies: a contact or a shell exit. Stale events and first
-predictions are popped from the queue but are no events.
+Its codes — event partners, statuses, counters and accumulators — and the words for what it
+counts are in :mod:`sim.engine.codes`.
 
 The loop takes its arguments in named groups (:mod:`sim.engine.groups`); the effects a scene
 uses arrive in :class:`sim.effects.Effects`, each None when off, and act through the rules of
@@ -42,6 +41,33 @@ from sim.effects.tc import tc_restitution
 from sim.effects.thermal_walls import contact_key
 from sim.effects.walls import hit_wall, predict_wall_contact
 from sim.engine.box import PERIODIC, SIDE
+from sim.engine.codes import (
+    COLLISIONS,
+    DISSIPATED_DISKS,
+    DISSIPATED_WALLS,
+    EVENTS,
+    NO_EVENT,
+    SHELL_EXIT,
+    SHELL_EXITS,
+    STALE_EVENTS,
+    STATUS_COLLAPSE,
+    STATUS_COLLISION_LIMIT,
+    STATUS_CONTACT_LIMIT,
+    STATUS_ENERGY_REACHED,
+    STATUS_EVENT_LIMIT,
+    STATUS_LIST_FULL,
+    STATUS_LOG_FULL,
+    STATUS_NO_EVENTS,
+    STATUS_STALLED,
+    STATUS_TIME_REACHED,
+    T_NOW,
+    T_ORIGIN,
+    UNPREDICTED,
+    VIRIAL,
+    WALL_CONTACTS,
+    WALL_WORK,
+    WALL_X_LOW,
+)
 from sim.engine.contact import collide_disks
 from sim.engine.flight import flown, fly, position_at, velocity_of
 from sim.engine.kinematics import (
@@ -59,55 +85,15 @@ from sim.engine.kinematics import (
     pair_contact_time,
     wrap,
 )
-from sim.engine.neighbours import list_start, prefetch_cells, rebuild_neighbours, shell_centre
+from sim.engine.lookahead import prefetch_upcoming
+from sim.engine.neighbours import list_start, rebuild_neighbours
 from sim.engine.parameters import per_disk
-from sim.engine.prefetch import prefetch
 from sim.engine.queue import (
-    HEAP_SIZE,
     build_queue,
     earliest,
     prefetch_bucket,
-    prefetch_next_block,
     reschedule,
 )
-
-# event partners other than a disk
-NO_EVENT = -1
-SHELL_EXIT = -2
-WALL_X_LOW = -3  # wall codes: WALL_X_LOW - (2 * axis + side)
-WALL_X_HIGH = -4
-WALL_Y_LOW = -5
-WALL_Y_HIGH = -6
-UNPREDICTED = -7  # a disk awaiting its first prediction, queued at the current time
-
-# loop status
-STATUS_EVENT_LIMIT = 1
-STATUS_COLLISION_LIMIT = 2
-STATUS_TIME_REACHED = 3
-STATUS_ENERGY_REACHED = 4
-STATUS_NO_EVENTS = 5
-STATUS_CONTACT_LIMIT = 6
-STATUS_LOG_FULL = 7
-STATUS_COLLAPSE = -1
-STATUS_LIST_FULL = -2
-STATUS_STALLED = -3
-
-# counters: int64[N_COUNTERS]
-EVENTS = 0  # applied events: contacts and shell exits
-COLLISIONS = 1  # disk–disk contacts
-WALL_CONTACTS = 2
-SHELL_EXITS = 3
-STALE_EVENTS = 4  # popped, found stale, dropped
-N_COUNTERS = 5
-
-# accumulators: float64[N_ACCUMULATORS]
-T_ORIGIN = 0  # absolute time of the clock's zero
-T_NOW = 1  # time of the last event, relative to T_ORIGIN
-DISSIPATED_DISKS = 2
-DISSIPATED_WALLS = 3
-VIRIAL = 4  # Σ r_ij·Δp_i over collisions
-WALL_WORK = 5  # work done by moving and thermal walls on the disks
-N_ACCUMULATORS = 6
 
 
 @njit(cache=True, inline="always")
@@ -182,91 +168,6 @@ def set_event(i, when, partner, partner_count, schedule):
     schedule.event_partner[i] = partner
     if partner >= 0:
         schedule.event_count[i] = partner_count
-
-
-@njit(cache=True, inline="always")
-def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule, neighbours,
-                      box):
-    """Ask the CPU to start loading what the next events will read while this one is worked on
-    (hints only: no result changes). A disk's data is hinted in stages, one event apart, each
-    stage reading what the one before brought in: the partner of this event and the disks of
-    the next two in the heap (heap slots 1, 2); with ``lookahead``, also the third, and for the
-    next two the rows their predictions read (their neighbours' rows and collision counts),
-    their partners' data, or, for a shell exit, the cells it scans, its own cell links and the
-    lists and counts of its neighbours, which its rebuild edits; and the bucket that becomes
-    the heap next
-    (:func:`sim.engine.queue.prefetch_next_block`: one of its disks per event, whose row,
-    partner and list are hinted too, for the first events of the next block would otherwise
-    reach the heap top with nothing fetched). Returns the bucket walk's state.
-
-    Against the hints without ``lookahead`` (``benchmarks/compare_builds.py``, φ = 0.5): 1.49
-    at N = 1e5, 1.39 at 1e6, 1.11 at 5e4, but 0.94 at 3e4, where the state still sits mostly
-    in cache (hence :data:`sim.engine.sizing.LOOKAHEAD_MIN_DISKS`). The hints for the walked disks'
-    rows, partners and lists, with blocks of 8 mean event times instead of 4
-    (:data:`sim.engine.queue.BLOCK_EVENTS`), against neither: 1.07, 1.12 and 1.11 at N = 1e5
-    (quartiles of rounds 0.98–1.17, 1.04–1.22, 1.05–1.17), 1.05 at 1e6 (1.02–1.12). The
-    hints for the neighbours' collision counts, the list lengths and a shell exit's cell links
-    and edited lists, with the loop's :func:`sim.engine.queue.prefetch_bucket`, against none of
-    them (on a day a miss took 200 ns): 1.135 at N = 1e5 (1.03–1.20), 1.26 at φ = 0.1, 1.20
-    at 1e6 (1.13–1.33).
-    """
-    table, coll_count = disks.table, disks.coll_count
-    event_partner, event_count, heap, links = (schedule.event_partner, schedule.event_count,
-                                               schedule.heap, schedule.links)
-    nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
-    if partner >= 0:
-        prefetch(table, partner)
-        prefetch(coll_count, partner)
-        prefetch(links, partner)
-        start = list_start(nb_start, partner)
-        prefetch(nb, start)
-        if lookahead:
-            for k in range(start, start + nb_count[partner]):
-                prefetch(table, nb[k])
-                prefetch(coll_count, nb[k])
-    size = schedule.calendar[HEAP_SIZE]
-    for slot in range(1, min(4 if lookahead else 3, size)):
-        c = heap[slot]
-        prefetch(table, c)
-        prefetch(event_partner, c)
-        prefetch(nb, list_start(nb_start, c))
-        if lookahead:
-            prefetch(event_count, c)
-            prefetch(coll_count, c)
-            prefetch(links, c)
-            prefetch(nb_count, c)
-    if not lookahead:
-        return walker, walker_block
-    for slot in range(1, min(3, size)):
-        c = heap[slot]
-        partner_c = event_partner[c]
-        start = list_start(nb_start, c)
-        for k in range(start, start + nb_count[c]):
-            prefetch(table, nb[k])
-            prefetch(coll_count, nb[k])
-            if partner_c == SHELL_EXIT:
-                prefetch(nb, list_start(nb_start, nb[k]))
-                prefetch(nb_count, nb[k])
-        if partner_c >= 0:
-            prefetch(table, partner_c)
-            prefetch(nb, list_start(nb_start, partner_c))
-            prefetch(nb_count, partner_c)
-            prefetch(coll_count, partner_c)
-            prefetch(event_count, partner_c)
-        elif partner_c == SHELL_EXIT:
-            prefetch(neighbours.cell_of, c)
-            prefetch(neighbours.cell_prev, c)
-            cx, cy = shell_centre(c, table, disks.delta, box.geometry, box.grid)
-            prefetch_cells(cx, cy, slot == 1, table, neighbours.cell_head, neighbours.cell_next,
-                           box.geometry, box.grid)
-    walker, walker_block = prefetch_next_block(walker, walker_block, links, schedule.list_head,
-                                               schedule.calendar, schedule.event_time)
-    if walker >= 0:
-        prefetch(table, walker)
-        prefetch(event_partner, walker)
-        prefetch(nb, list_start(nb_start, walker))
-        prefetch(nb_count, walker)
-    return walker, walker_block
 
 
 @njit(cache=True, inline="always")
@@ -377,38 +278,48 @@ def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origi
 
 
 @njit(cache=True, inline="always")
-def limit_reached(limits, events, collisions, wall_contacts, dissipated, log_full):
-    """The status of the first limit of ``limits`` the tallies have reached, else 0."""
-    if events >= limits.max_events:
-        return STATUS_EVENT_LIMIT
-    if collisions >= limits.max_collisions:
-        return STATUS_COLLISION_LIMIT
-    if collisions + wall_contacts >= limits.max_contacts:
-        return STATUS_CONTACT_LIMIT
-    if dissipated >= limits.dissipation_limit:
-        return STATUS_ENERGY_REACHED
-    if log_full:
-        return STATUS_LOG_FULL
-    return 0
+def stop_status(limits, partner, t, t_stop, t_previous, stalled, stall_limit, events, collisions,
+                wall_contacts, dissipated, log_full):
+    """The status that ends the loop before the event of ``partner`` at time t (relative
+    clock; ``t_stop`` on the same clock), or 0, and the length of the stall run.
+
+    In this order: the limits of ``limits`` on the tallies (not for a first prediction, which
+    is made whatever they are), the time limit, the end of all events, and a stall — more than
+    ``stall_limit`` = 16 N + 1000 events in a row, each at most ``limits.stall_dt`` after the
+    one before (a time of float64 resolution, :data:`sim.engine.sizing.STALL_RESOLUTION`),
+    which ends the loop instead of hanging it."""
+    if partner != UNPREDICTED:
+        if events >= limits.max_events:
+            return STATUS_EVENT_LIMIT, stalled
+        if collisions >= limits.max_collisions:
+            return STATUS_COLLISION_LIMIT, stalled
+        if collisions + wall_contacts >= limits.max_contacts:
+            return STATUS_CONTACT_LIMIT, stalled
+        if dissipated >= limits.dissipation_limit:
+            return STATUS_ENERGY_REACHED, stalled
+        if log_full:
+            return STATUS_LOG_FULL, stalled
+    if t > t_stop:
+        return STATUS_TIME_REACHED, stalled
+    if t == INF:
+        return STATUS_NO_EVENTS, stalled
+    if t - t_previous > limits.stall_dt:
+        return 0, np.int64(0)
+    if stalled + 1 > stall_limit:
+        return STATUS_STALLED, stalled + 1
+    return 0, stalled + 1
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
-    """Process events in time order until a limit is met; see the module docstring.
+    """Process events in time order until :func:`stop_status` ends the loop; see the module
+    docstring. Returns (status, the disk it concerns or −1).
 
-    Limits (:class:`sim.engine.groups.Limits`): ``max_events`` (events: the chunk size),
-    ``max_contacts`` and ``max_collisions`` are totals of ``tallies.counters``; ``t_stop`` is
-    an absolute time (events after it stay scheduled); ``dissipation_limit`` the energy whose
-    dissipation ends the run. A stall — more than 16 N + 1000 events in a row, each at most
-    ``stall_dt`` after the one before (a time of float64 resolution,
-    :data:`sim.engine.sizing.STALL_RESOLUTION`) — ends the loop instead of hanging it;
-    ``tallies.stall_watch`` holds the time of the last event popped (relative clock) and the
-    length of that run, carried from one call to the next. ``lookahead``: prefetch several
-    events ahead, and the candidates of a shell exit's cell scan, for states larger than the
-    caches (:func:`prefetch_upcoming`, :func:`sim.engine.neighbours._prefetch_candidates`).
-
-    Counters and accumulators live in local variables (registers) during the loop and are
-    written back to ``tallies`` when it stops.
+    ``tallies.stall_watch`` carries the time of the last event popped (relative clock) and
+    the length of its stall run from one call to the next; counters and accumulators live in
+    local variables (registers) during the loop and are written back when it stops.
+    ``limits.lookahead``: prefetch several events ahead, for states larger than the caches
+    (:func:`sim.engine.lookahead.prefetch_upcoming`).
     """
     counters, accumulators = tallies.counters, tallies.accumulators
     events = counters[EVENTS]
@@ -424,7 +335,6 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
     log_full = False
     t_stop = limits.t_stop - accumulators[T_ORIGIN]
     events_to_rebase = limits.rebase_every - events % limits.rebase_every
-    status = 0
     culprit = -1
     t_previous = tallies.stall_watch[0]
     stalled = np.int64(tallies.stall_watch[1])
@@ -435,22 +345,12 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
     while True:
         i = earliest(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time)
         partner = s.event_partner[i]
-        if partner != UNPREDICTED:  # a first prediction is made whatever the limits
-            status = limit_reached(limits, events, collisions, wall_contacts,
-                                   dissipated_disks + dissipated_walls, log_full)
-            if status != 0:
-                break
         t = s.event_time[i]
-        if t > t_stop:
-            status = STATUS_TIME_REACHED
-            break
-        if t == INF:
-            status = STATUS_NO_EVENTS
-            break
-        stalled = stalled + 1 if t - t_previous <= limits.stall_dt else 0
-        if stalled > stall_limit:
-            status = STATUS_STALLED
-            culprit = i
+        status, stalled = stop_status(limits, partner, t, t_stop, t_previous, stalled,
+                                      stall_limit, events, collisions, wall_contacts,
+                                      dissipated_disks + dissipated_walls, log_full)
+        if status != 0:
+            culprit = i if status == STATUS_STALLED else -1
             break
         t_previous = t
         walker, walker_block = prefetch_upcoming(partner, limits.lookahead, walker, walker_block,

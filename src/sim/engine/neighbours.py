@@ -133,7 +133,7 @@ def _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
 
 
 @njit(cache=True, inline="always")
-def _axis_span(c, k, nc, periodic):
+def axis_span(c, k, nc, periodic):
     """Cells c - k … c + k along an axis of nc cells: a half-open range of cell indices, which
     run beyond 0 … nc - 1 on a periodic axis (images, see :func:`_fold`)."""
     if periodic:
@@ -173,7 +173,7 @@ def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta
 @njit(cache=True, inline="always")
 def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid):
     """Hint the cache for the row of every disk filed in the cells of a scan (spans of
-    :func:`_axis_span`), before the scan reads them.
+    :func:`axis_span`), before the scan reads them.
 
     The scan walks each cell's linked list and tests every disk it meets, so without hints
     its loads of the disks' rows wait one after another, as far as the CPU can run ahead of
@@ -228,8 +228,8 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
         reach = disks[i, RADIUS] + per_disk(delta, i) + geometry[REACH]
         kx = int(math.ceil(reach / geometry[CELL_SIDE]))
         ky = int(math.ceil(reach / geometry[CELL_SIDE + 1]))
-    x_lo, x_hi = _axis_span(c % ncx, kx, ncx, grid[PERIODIC] != 0)
-    y_lo, y_hi = _axis_span(c // ncx, ky, ncy, grid[PERIODIC + 1] != 0)
+    x_lo, x_hi = axis_span(c % ncx, kx, ncx, grid[PERIODIC] != 0)
+    y_lo, y_hi = axis_span(c // ncx, ky, ncy, grid[PERIODIC + 1] != 0)
     free = list_start(nb_start, i) + nb_count[i]
     room = per_disk(nb_cap, i) - nb_count[i]
     if hint_candidates:
@@ -263,8 +263,8 @@ def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
     ncx = grid[CELLS]
     ncy = grid[CELLS + 1]
     c = cell_index(x, y, geometry, grid)
-    x_lo, x_hi = _axis_span(c % ncx, 1, ncx, grid[PERIODIC] != 0)
-    y_lo, y_hi = _axis_span(c // ncx, 1, ncy, grid[PERIODIC + 1] != 0)
+    x_lo, x_hi = axis_span(c % ncx, 1, ncx, grid[PERIODIC] != 0)
+    y_lo, y_hi = axis_span(c // ncx, 1, ncy, grid[PERIODIC + 1] != 0)
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
         if not members:

@@ -7,7 +7,7 @@ import numpy as np
 from sim.effects.event_log import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
 from sim.effects.gravity import potential_energy
 from sim.effects.walls import wall_state
-from sim.engine import loop
+from sim.engine import codes, loop
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
 
 
@@ -17,15 +17,15 @@ class Observables:
     @property
     def time(self):
         """Absolute time of the last processed event."""
-        return float(self.accumulators[loop.T_ORIGIN] + self.accumulators[loop.T_NOW])
+        return float(self.accumulators[codes.T_ORIGIN] + self.accumulators[codes.T_NOW])
 
     @property
     def collisions(self):
-        return int(self.counters[loop.COLLISIONS])
+        return int(self.counters[codes.COLLISIONS])
 
     @property
     def wall_collisions(self):
-        return int(self.counters[loop.WALL_CONTACTS])
+        return int(self.counters[codes.WALL_CONTACTS])
 
     @property
     def events(self):
@@ -35,17 +35,17 @@ class Observables:
     @property
     def steps(self):
         """Events the engine applied: contacts and neighbour-shell exits."""
-        return int(self.counters[loop.EVENTS])
+        return int(self.counters[codes.EVENTS])
 
     @property
     def dissipated_energy(self):
-        return float(self.accumulators[loop.DISSIPATED_DISKS]
-                     + self.accumulators[loop.DISSIPATED_WALLS])
+        return float(self.accumulators[codes.DISSIPATED_DISKS]
+                     + self.accumulators[codes.DISSIPATED_WALLS])
 
     @property
     def virial(self):
         """Σ r_ij·Δp_i over all disk–disk contacts so far."""
-        return float(self.accumulators[loop.VIRIAL])
+        return float(self.accumulators[codes.VIRIAL])
 
     def _user_order(self, values):
         out = np.empty_like(values)
@@ -53,8 +53,8 @@ class Observables:
         return out
 
     def _relative_time(self, t):
-        return (self.accumulators[loop.T_NOW] if t is None
-                else float(t) - self.accumulators[loop.T_ORIGIN])
+        return (self.accumulators[codes.T_NOW] if t is None
+                else float(t) - self.accumulators[codes.T_ORIGIN])
 
     def _state(self, t):
         return loop.state_at(self._relative_time(t), self.disks.table, self.geometry,
@@ -95,7 +95,7 @@ class Observables:
     def next_event_time(self):
         """Absolute time of the next scheduled event (possibly stale)."""
         d = self.disks
-        return float(d.event_time.min() + self.accumulators[loop.T_ORIGIN])
+        return float(d.event_time.min() + self.accumulators[codes.T_ORIGIN])
 
     def kinetic_energy_by_species(self, t=None):
         """Σ m v²/2 per species at time t: float64[n_species]."""
@@ -115,7 +115,7 @@ class Observables:
     @property
     def wall_work(self):
         """Work done on the disks by moving and thermal walls so far."""
-        return float(self.accumulators[loop.WALL_WORK])
+        return float(self.accumulators[codes.WALL_WORK])
 
     def momentum(self, t=None):
         d = self.disks

@@ -7,6 +7,7 @@ import numpy as np
 from numba import njit
 
 from sim.engine.kinematics import minimum_image
+from sim.engine.neighbours import axis_span
 from sim.engine.sizing import cell_limit, grid_cells
 
 
@@ -48,19 +49,8 @@ def _first_overlap(position, radius, level, reach, cells, box, periodic, toleran
             cy = min(int(y / width_y), ny - 1)
             kx = int(math.ceil((radius[i] + reach[k]) / width_x))
             ky = int(math.ceil((radius[i] + reach[k]) / width_y))
-            # a periodic axis narrower than the reach: every cell, each once
-            if not periodic[0]:
-                x_lo, x_hi = max(cx - kx, 0), min(cx + kx + 1, nx)
-            elif 2 * kx + 1 < nx:
-                x_lo, x_hi = cx - kx, cx + kx + 1
-            else:
-                x_lo, x_hi = 0, nx
-            if not periodic[1]:
-                y_lo, y_hi = max(cy - ky, 0), min(cy + ky + 1, ny)
-            elif 2 * ky + 1 < ny:
-                y_lo, y_hi = cy - ky, cy + ky + 1
-            else:
-                y_lo, y_hi = 0, ny
+            x_lo, x_hi = axis_span(cx, kx, nx, periodic[0])
+            y_lo, y_hi = axis_span(cy, ky, ny, periodic[1])
             for ay in range(y_lo, y_hi):
                 row = first_cell[k] + (ay % ny) * nx
                 for ax in range(x_lo, x_hi):

@@ -47,7 +47,7 @@ YEAR_END = 2
 
 #: Block width in mean times between events. With 8 instead of 4 the heap holds more of
 #: the next events and is refilled half as often, which gives the prefetching of
-#: :func:`sim.engine.loop.prefetch_upcoming` more to work ahead on: 1.09 at N = 1e5
+#: :func:`sim.engine.lookahead.prefetch_upcoming` more to work ahead on: 1.09 at N = 1e5
 #: (φ = 0.5, ``benchmarks/compare_builds.py``, 16 rounds), 16 gave 1.08; 0.99 at 1e4.
 BLOCK_EVENTS = 8.0
 #: Buckets per disk (rounded up to a power of two).

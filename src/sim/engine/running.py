@@ -8,7 +8,7 @@ import time as wallclock
 import numpy as np
 
 from sim.effects.walls import piston_jam
-from sim.engine import loop
+from sim.engine import codes, loop
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
 from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
 from sim.engine.kinematics import VX, VY, X, Y
@@ -28,7 +28,8 @@ class Running:
     def _run_chunk(self, max_events, max_contacts, max_collisions, t_stop, dissipation_limit):
         while True:
             d = self.disks
-            reorder_at = (self.counters[loop.EVENTS] // self.reorder_every + 1) * self.reorder_every
+            every = self.reorder_every
+            reorder_at = (self.counters[codes.EVENTS] // every + 1) * every
             status, disk = loop.run_events(
                 Disks(d.table, *self._per_disk_parameters(), d.coll_count, d.contacts,
                       d.t_last, d.streak),
@@ -42,16 +43,16 @@ class Running:
                 Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
                        dissipation_limit, self.stall_dt, self.rebase_every, self.lookahead))
             self.drain_event_log()
-            if status == loop.STATUS_LOG_FULL:
+            if status == codes.STATUS_LOG_FULL:
                 continue
-            if status == loop.STATUS_EVENT_LIMIT and self.counters[loop.EVENTS] == reorder_at:
+            if status == codes.STATUS_EVENT_LIMIT and self.counters[codes.EVENTS] == reorder_at:
                 self.reorder()
                 if reorder_at < max_events:
                     continue
-            if status == loop.STATUS_LIST_FULL:
+            if status == codes.STATUS_LIST_FULL:
                 self._grow_lists(disk)
                 continue
-            if status == loop.STATUS_STALLED:
+            if status == codes.STATUS_STALLED:
                 self._check_piston()  # a jammed piston stalls the clock too: say so
                 raise StalledError(
                     f"the clock has stalled at t = {self.time:.17g}: more than 16 N + 1000 "
@@ -62,7 +63,7 @@ class Running:
                     f"resolution: for inelastic disks, and for disks resting on a wall under "
                     f"gravity, switch on the TC model (tc.time); a chain of disks touching all "
                     f"round a periodic box needs room between its disks")
-            if status == loop.STATUS_COLLAPSE:
+            if status == codes.STATUS_COLLAPSE:
                 cluster = set(np.flatnonzero(d.streak >= 2).tolist()) | {int(disk)}
                 raise InelasticCollapseError(sorted(int(d.order[k]) for k in cluster),
                                              self.time, self.collisions)
@@ -99,10 +100,10 @@ class Running:
         dissipation_limit = (math.inf if energy_fraction is None
                              else self.initial_energy * (1.0 - float(energy_fraction)))
         started = wallclock.perf_counter()
-        reasons = {loop.STATUS_COLLISION_LIMIT: "collisions", loop.STATUS_CONTACT_LIMIT: "events",
-                   loop.STATUS_TIME_REACHED: "time",
-                   loop.STATUS_ENERGY_REACHED: "energy_fraction",
-                   loop.STATUS_NO_EVENTS: "no_events"}
+        reasons = {codes.STATUS_COLLISION_LIMIT: "collisions", codes.STATUS_CONTACT_LIMIT: "events",
+                   codes.STATUS_TIME_REACHED: "time",
+                   codes.STATUS_ENERGY_REACHED: "energy_fraction",
+                   codes.STATUS_NO_EVENTS: "no_events"}
         chunk = int(chunk_events) if wall_seconds is None else min(int(chunk_events),
                                                                    TIMED_FIRST_CHUNK)
         ask_at = self.steps + int(chunk_events)  # where ``until`` is asked next
@@ -112,8 +113,8 @@ class Running:
             status = self._run_chunk(min(steps + chunk, ask_at), max_contacts, max_collisions,
                                      t_stop, dissipation_limit)
             self._check_piston()
-            if status != loop.STATUS_EVENT_LIMIT:
-                if closing and status == loop.STATUS_TIME_REACHED:
+            if status != codes.STATUS_EVENT_LIMIT:
+                if closing and status == codes.STATUS_TIME_REACHED:
                     raise ClosedBoxError(
                         f"at t = {self.closing_time:.6g} the moving walls come within the "
                         f"largest disk diameter ({2 * self.radius.max():.6g}) of the opposite "
