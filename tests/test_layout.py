@@ -19,7 +19,9 @@ def test_old_path_gives_the_module_with_a_warning(old):
     assert module is importlib.import_module(MOVED[old])
 
 
-def test_old_command_path_runs():
-    out = subprocess.run([sys.executable, "-m", "sim.inspect", "--help"], capture_output=True,
-                         text=True, check=True)
-    assert out.stdout.startswith("usage: sim-inspect")
+@pytest.mark.parametrize("old, command", [("sim.inspect", "sim-inspect"),
+                                          ("sim.movie", "sim-movie")])
+def test_old_command_path_runs(old, command):
+    out = subprocess.run([sys.executable, "-m", old, "--help"], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.startswith(f"usage: {command}")

@@ -2,6 +2,8 @@
 latest snapshot, drawn where the positions say; MP4 or GIF written whole; bad input is one line and
 exit status 2."""
 
+import subprocess
+import sys
 import warnings
 
 import imageio_ffmpeg
@@ -12,6 +14,10 @@ from scipy import ndimage
 
 from sim.analysis.datasets import open_run
 from sim.figures import movie
+from sim.figures.movie.colors import cluster_rule
+from sim.figures.movie.layout import Layout
+from sim.figures.movie.picture import Picture
+from sim.figures.movie.snapshots import Snapshots, free_flight, latest_snapshots
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
@@ -49,18 +55,17 @@ def test_free_flight_from_sparse_snapshots_gives_the_dense_ones_between_contacts
         time = ds["time"].values
         position, velocity = ds["position"].values, ds["velocity"].values
         contacts = ds["collisions"].values + ds["wall_collisions"].values
-        snapshots = movie.Snapshots(ds)
+        snapshots = Snapshots(ds)
         gravity, box, periodic = snapshots.gravity, snapshots.box, snapshots.periodic
     assert (gravity is not None) == (scene == "walls_and_gravity")
     sparse = np.arange(0, time.size, 10)
-    latest, elapsed = movie.latest_snapshots(time[sparse], time)
+    latest, elapsed = latest_snapshots(time[sparse], time)
     k = sparse[latest]
     assert np.all(time[k] <= time) and np.all(elapsed >= 0.0)  # never predicted backwards
     free = contacts[k] == contacts  # no contact between the sparse snapshot and this one
     assert free.sum() > 0.8 * time.size and np.sum(elapsed[free] > 0.0) > 100
     for j in np.flatnonzero(free):
-        r, v = movie.free_flight(position[k[j]], velocity[k[j]], elapsed[j], gravity, box,
-                                 periodic)
+        r, v = free_flight(position[k[j]], velocity[k[j]], elapsed[j], gravity, box, periodic)
         np.testing.assert_allclose(v, velocity[j], rtol=0.0, atol=1e-12)
         apart = r - position[j]
         apart -= np.where(periodic, box * np.round(apart / box), 0.0)  # x = 0 is x = L
@@ -76,12 +81,12 @@ def test_frames_show_the_disks_where_free_flight_puts_them(runs, tmp_path):
     times = np.linspace(0.105, 1.9, 12)  # between snapshots, from the latest before each
     movie.make_movie(runs["walls_and_gravity"], out, fps=10, frames=times.size,
                      start=times[0], stop=times[-1], color="species")
-    layout = movie.Layout.of_view((0.0, 1.0, 0.0, 1.0))
+    layout = Layout.of_view((0.0, 1.0, 0.0, 1.0))
     size, frames = read_mp4(out)
     assert size == (layout.width, layout.height) and len(frames) == times.size
     assert layout.width % 16 == 0 and layout.height % 16 == 0
     with open_run(runs["walls_and_gravity"]) as ds:
-        expected = [f.position for f in movie.Snapshots(ds).frames(times)]
+        expected = [f.position for f in Snapshots(ds).frames(times)]
         radius = float(ds["radius"][0])
     radius_pixels = radius * layout.box_width
     checked = 0
@@ -114,7 +119,7 @@ def test_gif_by_name_and_when_ffmpeg_is_unavailable(runs, tmp_path, monkeypatch,
     with Image.open(gif) as image:
         assert image.n_frames == 4
         width, height = image.size
-    layout = movie.Layout.of_view((0.0, 1.0, 0.0, 1.0))
+    layout = Layout.of_view((0.0, 1.0, 0.0, 1.0))
     assert (width, height) == (layout.width, layout.height)
 
     def unavailable():
@@ -132,7 +137,7 @@ def test_gif_by_name_and_when_ffmpeg_is_unavailable(runs, tmp_path, monkeypatch,
 
 
 def test_a_movie_that_fails_leaves_no_file(runs, tmp_path, monkeypatch):
-    render = movie.Picture.render
+    render = Picture.render
     drawn = []
 
     def failing(picture, frame):
@@ -141,7 +146,7 @@ def test_a_movie_that_fails_leaves_no_file(runs, tmp_path, monkeypatch):
             raise OSError("disk full")
         return render(picture, frame)
 
-    monkeypatch.setattr(movie.Picture, "render", failing)
+    monkeypatch.setattr(Picture, "render", failing)
     assert movie.main([str(runs["periodic"]), "--out", str(tmp_path / "m.mp4"),
                        "--frames", "5"]) == 1
     assert list(tmp_path.iterdir()) == []
@@ -164,7 +169,7 @@ def test_frames_across_contacts_are_noted_in_one_line(runs, tmp_path, capsys):
 
 def test_cluster_labels_follow_the_rule_of_the_observer(runs):
     with open_run(runs["periodic"]) as ds:
-        labels = movie.cluster_rule(movie.Snapshots(ds), ds["radius"].values)
+        labels = cluster_rule(Snapshots(ds), ds["radius"].values)
         observed = ds["clusters"].values
         position = ds["position"].values
     assert all(np.array_equal(labels(p), o) for p, o in zip(position, observed, strict=True))
@@ -193,3 +198,9 @@ def test_bad_input_is_one_line_and_status_2(runs, tmp_path, monkeypatch, capsys,
     assert len(err.splitlines()) == 1 and says in err and err.startswith("sim-movie: ")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_run.h5"]
     assert not any(p.suffix in (".mp4", ".gif") for p in runs["periodic"].parent.iterdir())
+
+
+def test_the_command_runs_as_a_module():
+    out = subprocess.run([sys.executable, "-m", "sim.figures.movie", "--help"],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.startswith("usage: sim-movie")

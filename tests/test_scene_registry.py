@@ -1,6 +1,6 @@
 """One registry of scenes: every scene in :data:`sim.pipeline.scenes.SCENES` has its scenario
-file, its schema sections, its builder, preparation and checks, and composes and builds; no
-scenario file names a scene the registry lacks."""
+file, its schema sections, its builder, preparation, checks and disk count, and composes and
+builds; no scenario file names a scene the registry lacks."""
 
 import typing
 from dataclasses import fields, is_dataclass
@@ -9,10 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from omegaconf import OmegaConf
 
+from sim.pipeline import resources
 from sim.pipeline.cli import CONF_DIR
 from sim.pipeline.config import ConfigError, SimConfig, validate
-from sim.pipeline.scenes import BUILDERS, PREPARATIONS, SCENES, build_scene, preparation
+from sim.pipeline.scenes import BUILDERS, PREPARATIONS, SCENES, SceneSpec, build_scene, preparation
 from test_pipeline import compose_scene
 
 SCENARIO_DIR = Path(CONF_DIR, "scenario")
@@ -50,6 +52,18 @@ def test_builders_and_preparations_are_those_of_the_registry():
         assert scene.name == name
         assert BUILDERS[name] is scene.builder and PREPARATIONS[name] is scene.preparation
         assert callable(scene.check)
+        assert callable(scene.disk_count) and callable(scene.packing_fraction)
+
+
+def test_a_scene_without_its_disk_count_is_refused():
+    with pytest.raises(TypeError, match="disk_count"):
+        SceneSpec("nosuch", SCENES["gas"].builder)
+
+
+def test_a_stored_scene_outside_the_registry_counts_disks_n():
+    """A stored config is not validated: its scene may be unknown to the registry."""
+    cfg = compose_scene("crater", "scene=nosuch")
+    assert resources.disk_count(cfg) == (cfg.disks.n, "disks.n")
 
 
 def test_the_schema_sections_are_those_the_scenes_need():
@@ -80,6 +94,12 @@ def test_every_scene_composes_validates_and_builds(name):
         assert n == scene.fixed_count
     if scene.gas_like:
         assert n == cfg.disks.n
+    count, key = scene.disk_count(cfg)
+    assert count == n and resources.disk_count(cfg) == (count, key)
+    assert 0.0 < scene.packing_fraction(cfg, n) <= 0.9
+    if scene.fixed_count is None:  # the key sets the count
+        more = compose_scene(name, f"{key}={OmegaConf.select(cfg, key) + 1}")
+        assert scene.disk_count(more) == (n + 1, key)
 
 
 @pytest.mark.parametrize("name", sorted(SCENES))

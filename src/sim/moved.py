@@ -57,10 +57,14 @@ class MovedModules:
         pass
 
     def get_code(self, name):
-        """For ``python -m``: the code of the new module."""
+        """For ``python -m``: the code of the new module, or of its ``__main__`` if it is a
+        package."""
         from importlib.util import find_spec
 
-        return find_spec(self.new).loader.get_code(self.new)
+        spec = find_spec(self.new)
+        if spec.submodule_search_locations is not None:
+            spec = find_spec(f"{self.new}.__main__")
+        return spec.loader.get_code(spec.name)
 
 
 def install():

@@ -27,6 +27,7 @@ from pathlib import Path
 from omegaconf import OmegaConf
 
 from sim.pipeline.config import ConfigError
+from sim.pipeline.scenes import SCENES, box_packing, given_count
 
 BASE_BYTES = 400 << 20
 DISK_BYTES = 700
@@ -45,27 +46,15 @@ SURELY_KEPT = 0.45
 
 
 def disk_count(cfg):
-    """The number of disks the scene of ``cfg`` makes, and the key that sets it."""
-    if cfg.scene in ("crater", "vibrated_bed"):
-        return int(cfg.bed.n) + (cfg.scene == "crater"), "bed.n"
-    if cfg.scene == "single_disk":
-        return 1, "disks.n"
-    if cfg.scene in ("two_disks", "scattering"):
-        return 2, "disks.n"
-    return int(cfg.disks.n), "disks.n"
+    """The number of disks the scene of ``cfg`` makes, and the key that sets it; ``disks.n``
+    for a scene the registry lacks (a stored config that was not validated may name one)."""
+    scene = SCENES.get(cfg.scene)
+    return given_count(cfg) if scene is None else scene.disk_count(cfg)
 
 
 def _packing_fraction(cfg, n):
-    d = cfg.disks
-    if cfg.scene in ("crater", "vibrated_bed"):
-        return min(0.9, n * math.pi * float(cfg.bed.radius) ** 2
-                   / (float(cfg.box.size[0]) * float(cfg.bed.height)))
-    if d.packing_fraction is not None:
-        return float(d.packing_fraction)
-    if d.radius is None:
-        return 0.9
-    return min(0.9, n * math.pi * float(d.radius) ** 2
-               / (float(cfg.box.size[0]) * float(cfg.box.size[1])))
+    scene = SCENES.get(cfg.scene)
+    return box_packing(cfg, n) if scene is None else scene.packing_fraction(cfg, n)
 
 
 def _local_cells(cfg):

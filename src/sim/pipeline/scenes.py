@@ -1,13 +1,14 @@
 """Scenes: from a validated config to the initial state of the engine.
 
 Every scene is one :class:`SceneSpec` in :data:`SCENES`: its builder ``f(cfg) -> Scene``,
-how it places its disks in words, the schema sections it needs, the checks of its own keys,
-its fixed number of disks if it has one, and whether it is a gas filling the box. The
-config's list of scenes and its per-scene checks (:func:`sim.pipeline.config.validate`),
-:data:`BUILDERS` and :data:`PREPARATIONS` all come from it. Adding a scene is its builder
-and entry here, its section of the schema (:mod:`sim.pipeline.config`) if it has keys of its
-own, and ``conf/scenario/<name>.yaml``; ``tests/test_scene_registry.py`` checks that they
-agree. Positions and velocities are float64[n, 2] in box units.
+how many disks it makes and how densely they lie, how it places them in words, the schema
+sections it needs, the checks of its own keys, its fixed number of disks if it has one, and
+whether it is a gas filling the box. The config's list of scenes and its per-scene checks
+(:func:`sim.pipeline.config.validate`), :data:`BUILDERS`, :data:`PREPARATIONS` and the
+resource estimates (:mod:`sim.pipeline.resources`) all come from it. Adding a scene is its
+builder and entry here, its section of the schema (:mod:`sim.pipeline.config`) if it has keys
+of its own, and ``conf/scenario/<name>.yaml``; ``tests/test_scene_registry.py`` checks that
+they agree. Positions and velocities are float64[n, 2] in box units.
 """
 
 import math
@@ -53,14 +54,38 @@ def _no_checks(c):
     """A scene without keys of its own."""
 
 
+def given_count(cfg):
+    """``disks.n`` disks, and the key that sets them."""
+    return int(cfg.disks.n), "disks.n"
+
+
+def _always(n):
+    """The disk count ``f(cfg) -> (n, "disks.n")`` of a scene that always has ``n`` disks."""
+    return lambda cfg: (n, "disks.n")
+
+
+def box_packing(cfg, n):
+    """The packing fraction of ``n`` disks over the box: ``disks.packing_fraction``, or that of
+    ``disks.radius``, at most 0.9 (0.9 when neither is given)."""
+    d = cfg.disks
+    if d.packing_fraction is not None:
+        return float(d.packing_fraction)
+    if d.radius is None:
+        return 0.9
+    return min(0.9, n * math.pi * float(d.radius) ** 2
+               / (float(cfg.box.size[0]) * float(cfg.box.size[1])))
+
+
 @dataclass(frozen=True)
 class SceneSpec:
-    """A scene: the name the config gives it, how it is built and described, and how its
-    keys are checked."""
+    """A scene: the name the config gives it, how it is built and described, how many disks
+    it makes, and how its keys are checked."""
 
     name: str
     #: ``f(cfg) -> Scene``: the initial state
     builder: Callable
+    #: ``f(cfg) -> (n, key)``: how many disks the scene makes, and the key that sets that many
+    disk_count: Callable
     #: ``f(cfg) -> str``: how the initial state is made, in words
     preparation: Callable = _as_given
     #: the optional sections of the schema the scene needs (``bed``, ``projectile``, …)
@@ -72,6 +97,9 @@ class SceneSpec:
     fixed_count: Optional[int] = None
     #: a gas: ``disks.n`` disks fill the box at ``disks.packing_fraction``
     gas_like: bool = False
+    #: ``f(cfg, n) -> φ``: the packing fraction where the ``n`` disks lie (the resource
+    #: estimates count the pairs of g(r) by it)
+    packing_fraction: Callable = box_packing
 
 
 def _boundary(cfg):
@@ -263,6 +291,16 @@ def _bed_region(cfg):
     return (0.0, float(cfg.box.size[0])), (0.0, float(cfg.bed.height))
 
 
+def _bed_count(cfg):
+    return int(cfg.bed.n), "bed.n"
+
+
+def _bed_packing(cfg, n):
+    """The packing fraction of ``n`` disks of the bed's radius in the bed, at most 0.9."""
+    return min(0.9, n * math.pi * float(cfg.bed.radius) ** 2
+               / (float(cfg.box.size[0]) * float(cfg.bed.height)))
+
+
 def _bed(cfg):
     """Positions float64[n, 2] of the bed disks, at rest in 0 ≤ y ≤ bed.height."""
     b = cfg.bed
@@ -313,6 +351,11 @@ def _crater_preparation(cfg):
     return f"bed: {_bed_placement(cfg)}, then settled for t = {settle_time} under gravity"
 
 
+def _crater_count(cfg):
+    """The bed and the projectile."""
+    return int(cfg.bed.n) + 1, "bed.n"
+
+
 def _check_crater(c):
     """The bed and its settling under gravity; the projectile inside the box, above the bed."""
     _check_bed(c)
@@ -360,20 +403,20 @@ def crater(cfg):
 
 #: every scene, by name, in the order the config lists them
 SCENES = {spec.name: spec for spec in (
-    SceneSpec("single_disk", single_disk, fixed_count=1),
-    SceneSpec("two_disks", two_disks, sections=("two_disks",), check=_check_two_disks,
-              fixed_count=2),
-    SceneSpec("scattering", scattering, sections=("scattering",), check=_check_scattering,
-              fixed_count=2),
-    SceneSpec("gas", gas, preparation=_gas_preparation, gas_like=True),
-    SceneSpec("mixture", mixture, preparation=_gas_preparation, sections=("mixture",),
-              check=_check_mixture, gas_like=True),
-    SceneSpec("crater", crater, preparation=_crater_preparation,
-              sections=("projectile", "bed"), check=_check_crater),
-    SceneSpec("cooling", gas, preparation=_gas_preparation, gas_like=True),
-    SceneSpec("driven", gas, preparation=_gas_preparation, gas_like=True),
-    SceneSpec("vibrated_bed", vibrated_bed, preparation=_bed_preparation, sections=("bed",),
-              check=_check_vibrated_bed),
+    SceneSpec("single_disk", single_disk, _always(1), fixed_count=1),
+    SceneSpec("two_disks", two_disks, _always(2), sections=("two_disks",),
+              check=_check_two_disks, fixed_count=2),
+    SceneSpec("scattering", scattering, _always(2), sections=("scattering",),
+              check=_check_scattering, fixed_count=2),
+    SceneSpec("gas", gas, given_count, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("mixture", mixture, given_count, preparation=_gas_preparation,
+              sections=("mixture",), check=_check_mixture, gas_like=True),
+    SceneSpec("crater", crater, _crater_count, preparation=_crater_preparation,
+              sections=("projectile", "bed"), check=_check_crater, packing_fraction=_bed_packing),
+    SceneSpec("cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("driven", gas, given_count, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("vibrated_bed", vibrated_bed, _bed_count, preparation=_bed_preparation,
+              sections=("bed",), check=_check_vibrated_bed, packing_fraction=_bed_packing),
 )}
 
 #: scene name → ``f(cfg) -> Scene``

@@ -1,0 +1,146 @@
+"""A run's snapshots and the times of a movie's frames.
+
+Frames are evenly spaced in simulated time from --start to --stop (default: the first and the
+last snapshot), one per snapshot in between (at most 30 s of movie) unless --frames or
+--duration (seconds of movie at --fps) says otherwise. A frame at time t draws each disk in
+free flight from the latest snapshot k at or before t, never back from a later one:
+r = r_k + v_k (t − t_k) + ½ g (t − t_k)² and v = v_k + g (t − t_k), g the run's gravity (box
+units / time²), r wrapped into the box along periodic axes.
+Contacts between snapshots are not drawn: between two snapshots a disk may pass through a
+neighbour or a wall. A disk drawn a time s after its snapshot has met something with
+probability about s/τ (τ its mean free time); frames between snapshots lie on average half an
+interval Δ after theirs, so about Δ/(2τ) of their disks are off their true path
+(:meth:`Snapshots.missed_contacts` measures Δ/τ).
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import yaml
+
+from sim.effects.gravity import gravity_vector
+from sim.pipeline.command import BadInput
+
+#: the longest movie made by default, one frame per snapshot (seconds)
+DEFAULT_MAX_SECONDS = 30.0
+#: the fastest frame rate accepted (frames per second)
+MAX_FPS = 120.0
+
+
+def free_flight(position, velocity, elapsed, gravity=None, box=None, periodic=(False, False)):
+    """Positions and velocities float64[n, 2] a time ``elapsed`` ≥ 0 after a snapshot's
+    ``position`` and ``velocity``, every disk in free flight under ``gravity`` (float64[2] or
+    None), positions wrapped into ``box`` along ``periodic`` axes."""
+    acceleration = np.zeros(2) if gravity is None else np.asarray(gravity, dtype=np.float64)
+    moved = position + velocity * elapsed + 0.5 * acceleration * elapsed**2
+    if any(periodic):
+        moved = np.where(periodic, np.mod(moved, box), moved)
+    return moved, velocity + acceleration * elapsed
+
+
+def round_off(snapshot_times):
+    """The time within which two instants of a run are the same: a few ulps of the largest
+    snapshot time (snapshot times are multiples k Δt and frame times come from linspace, so
+    the same instant differs between them by round-off only)."""
+    return 8.0 * float(np.spacing(np.max(np.abs(snapshot_times))))
+
+
+def latest_snapshots(snapshot_times, times):
+    """For each of ``times``: the index of the latest snapshot at or before it, and the time
+    elapsed since (≥ 0); a time within :func:`round_off` of a snapshot is that snapshot's."""
+    tolerance = round_off(snapshot_times)
+    latest = np.searchsorted(snapshot_times, times + tolerance, side="right") - 1
+    latest = np.clip(latest, 0, snapshot_times.size - 1)
+    elapsed = times - snapshot_times[latest]
+    return latest, np.where(elapsed > tolerance, elapsed, 0.0)
+
+
+@dataclass
+class Frame:
+    """The disks at one frame's time, and the snapshot they fly from."""
+
+    time: float
+    snapshot: int  # index in the run file of the snapshot the disks fly from
+    position: np.ndarray  # float64[n, 2]
+    velocity: np.ndarray  # float64[n, 2]
+
+
+class Snapshots:
+    """A run's snapshots, read one at a time (``open_run`` reads positions lazily), and the
+    disks at any time between the first and the last, in free flight from the latest snapshot
+    at or before it."""
+
+    def __init__(self, ds):
+        self.ds = ds
+        times = ds["time"].values
+        self.readable = np.flatnonzero(np.isfinite(times))  # damaged times are NaN
+        if not self.readable.size:
+            raise BadInput(f"{ds.attrs['path']} holds no readable snapshot")
+        self.times = times[self.readable]
+        self.config = yaml.safe_load(ds.attrs["config"]) or {}
+        self.gravity = gravity_vector(self.config.get("gravity"))
+        self.box = np.asarray(ds.attrs["box"], dtype=np.float64)
+        self.periodic = tuple(side == "periodic" for side in ds.attrs["boundary"])
+        self._read = (None, None, None)
+
+    def _snapshot(self, index):
+        if self._read[0] != index:
+            self._read = (index, self.ds["position"][index].values,
+                          self.ds["velocity"][index].values)
+        return self._read[1:]
+
+    def frames(self, times):
+        """The :class:`Frame` at each of ``times``, in order."""
+        latest, elapsed = latest_snapshots(self.times, times)
+        for time, k, dt in zip(times, latest, elapsed, strict=True):
+            index = int(self.readable[k])
+            position, velocity = free_flight(*self._snapshot(index), dt, self.gravity, self.box,
+                                             self.periodic)
+            yield Frame(float(time), index, position, velocity)
+
+    def missed_contacts(self, times):
+        """How many of ``times`` fall inside snapshot intervals, the contacts per disk in the
+        average such interval, and its mean length (0, 0, 0 when every time is a
+        snapshot's)."""
+        latest, elapsed = latest_snapshots(self.times, times)
+        inside = np.unique(latest[elapsed > 0.0])
+        if not inside.size:
+            return 0, 0.0, 0.0
+        contacts = (2.0 * self.ds["collisions"].values + self.ds["wall_collisions"].values)
+        contacts = contacts[self.readable]
+        per_disk = (contacts[inside + 1] - contacts[inside]) / self.ds.sizes["disk"]
+        interval = self.times[inside + 1] - self.times[inside]
+        return (int(np.sum(elapsed > 0.0)), float(np.nanmean(per_disk)),
+                float(np.mean(interval)))
+
+
+def frame_times(snapshot_times, fps, frames=None, duration=None, start=None, stop=None):
+    """Times float64[F] of the frames, evenly spaced from ``start`` to ``stop`` (default the
+    first and last snapshot): ``frames`` of them, or ``duration`` × ``fps``, or one per
+    snapshot in between (at most DEFAULT_MAX_SECONDS of movie). Bad values: BadInput."""
+    if not 0.0 < fps <= MAX_FPS:
+        raise BadInput(f"--fps {fps}: a frame rate above 0 and at most {MAX_FPS:g}")
+    first, last = float(snapshot_times[0]), float(snapshot_times[-1])
+    start = first if start is None else start
+    stop = last if stop is None else stop
+    if not first <= start <= stop <= last:
+        raise BadInput(f"--start {start:.6g} and --stop {stop:.6g}: the run's snapshots span "
+                         f"t = {first:.6g} to {last:.6g}; a frame is drawn only from a snapshot "
+                         f"before it, so give {first:.6g} ≤ start ≤ stop ≤ {last:.6g}")
+    if duration is not None:
+        if not 0.0 < duration < math.inf:
+            raise BadInput(f"--duration {duration}: seconds of movie, above 0")
+        frames = round(duration * fps)
+        if frames < 1:
+            raise BadInput(f"--duration {duration} at --fps {fps:g} is less than one frame")
+    elif frames is None:
+        inside = snapshot_times[(snapshot_times >= start) & (snapshot_times <= stop)]
+        distinct = int(np.sum(np.diff(inside) > round_off(snapshot_times))) + 1
+        frames = max(1 if start == stop else 2, min(distinct, round(DEFAULT_MAX_SECONDS * fps)))
+    if frames < 1:
+        raise BadInput(f"--frames {frames}: at least one frame")
+    if frames > 1 and start == stop:
+        raise BadInput(f"--start and --stop are both {start:.6g}: one frame only "
+                         f"(--frames 1)")
+    return np.linspace(start, stop, frames)
