@@ -171,9 +171,9 @@ def test_a_write_the_system_refuses_unforeseen_ends_with_one_line(tmp_path):
 #: passed over, so the command must still say it, in one line, at exit
 UNREPORTED_FAILURE = """
 import atexit, sys
-from sim.pipeline import cli
-sys.excepthook = cli._quiet_hdf5_traceback
-atexit.register(cli._report_passed_over)
+from sim.pipeline import cli_exits
+sys.excepthook = cli_exits.quiet_hdf5_traceback
+atexit.register(cli_exits.report_passed_over)
 raise OSError("Driver write request failed (file write failed: errno = 27, "
               "error message = 'File too large')")
 """

@@ -159,11 +159,12 @@ def entry(monkeypatch, capsys, tmp_path):
     """``sim.pipeline.cli.main()`` in this process, in ``tmp_path``, stopped (HydraReached) if it
     gets as far as Hydra; returns a function of the command line giving a :class:`Result`."""
     import sim.pipeline.cli as main_module
+    import sim.pipeline.cli_exits as exits_module
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(main_module, "MADE_FOLDERS", [])
+    monkeypatch.setattr(exits_module, "MADE_FOLDERS", [])
     monkeypatch.setattr(main_module, "INTERRUPTED", [])
-    monkeypatch.setattr(main_module, "STOPPED_BY", [signal.SIGINT])
+    monkeypatch.setattr(exits_module, "STOPPED_BY", [signal.SIGINT])
     monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)
     monkeypatch.setattr(runner.Interruption, "at_second_signal", None)
 

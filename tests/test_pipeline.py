@@ -17,6 +17,7 @@ from sim.pipeline import runner
 from sim.pipeline.cli import CONF_DIR
 from sim.pipeline.config import ConfigError, register
 from sim.storage.errors import RunFileError
+from sim.storage.h5md import RunWriter
 from sim.storage.inspect import summary
 
 register()
@@ -71,7 +72,7 @@ def interrupted_at_the_fourth_snapshot(cfg, folder, monkeypatch, checkpoint_ever
     """Run ``cfg`` into ``folder`` until a KeyboardInterrupt at its fourth snapshot; with
     ``checkpoint_every_snapshot`` false only the first snapshot checkpoints and nothing is
     flushed before the interrupt. Returns the run file."""
-    original = runner.RunWriter.snapshot
+    original = RunWriter.snapshot
     calls = {"n": 0}
 
     def interrupted(self, engine, time=None, checkpoint=False):
@@ -83,10 +84,10 @@ def interrupted_at_the_fourth_snapshot(cfg, folder, monkeypatch, checkpoint_ever
             raise KeyboardInterrupt
 
     folder.mkdir()
-    monkeypatch.setattr(runner.RunWriter, "snapshot", interrupted)
+    monkeypatch.setattr(RunWriter, "snapshot", interrupted)
     with pytest.raises(KeyboardInterrupt):
         runner.run(cfg, folder)
-    monkeypatch.setattr(runner.RunWriter, "snapshot", original)
+    monkeypatch.setattr(RunWriter, "snapshot", original)
     return folder / "run.h5"
 
 

@@ -18,7 +18,7 @@ from sim.pipeline import runner
 from sim.pipeline.config import ConfigError
 from sim.pipeline.run_cache import compose_config
 from sim.storage.errors import RunFileError
-from sim.storage.h5md import read_checkpoint
+from sim.storage.h5md import RunWriter, read_checkpoint
 from sim.storage.inspect import main, summary
 
 #: 300 disks, 17 snapshots, checkpoints at the first snapshot (slot a) and the last (slot b)
@@ -165,7 +165,7 @@ def test_resume_falls_back_to_the_older_checkpoint_when_the_latest_is_damaged(in
                                   f"the checkpoint of snapshot 0 "):
         assert read_checkpoint(f)[2] == 1
     written = []  # the slot each new checkpoint goes to: never the only intact one
-    original = runner.RunWriter._checkpoint
+    original = RunWriter._checkpoint
 
     def recording(self, engine, t):
         written.append("b" if self.file["checkpoint"].attrs["latest"] == "a" else "a")
@@ -173,7 +173,7 @@ def test_resume_falls_back_to_the_older_checkpoint_when_the_latest_is_damaged(in
 
     with pytest.warns(RuntimeWarning, match=f"slot {slot} is damaged"):
         with pytest.MonkeyPatch.context() as patch:
-            patch.setattr(runner.RunWriter, "_checkpoint", recording)
+            patch.setattr(RunWriter, "_checkpoint", recording)
             runner.resume(path)
     assert written[0] == slot
     assert summary(path)["stop_reason"] == "collisions"

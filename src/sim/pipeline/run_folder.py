@@ -11,13 +11,20 @@ life, and a new run file that appears whole or not at all.
 * A new run file is written under the hidden name ``.run.h5.part`` (:func:`part_path`) and
   linked into place once its header, first snapshot and first checkpoint are on disk
   (:func:`publish`): a run killed at any moment leaves a readable run file or none.
+* :func:`locked` holds the lock for the pipeline: another process's lock is a config error,
+  a folder where no lock file can be made a run file error (:func:`cannot_write`).
 """
 
 import errno
 import fcntl
 import os
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
+
+from sim.pipeline.config import ConfigError
+from sim.storage.errors import RunFileError
+from sim.storage.h5md import hdf5_reason
 
 #: flock's errors on a file system that has no file locks (some Lustre and NFS mounts)
 NO_LOCKS = (errno.ENOLCK, errno.ENOSYS, errno.EOPNOTSUPP)
@@ -122,3 +129,29 @@ def publish(part, path):
         os.rename(part, path)
         return
     os.unlink(part)
+
+
+def cannot_write(path, error, then=""):
+    """:class:`RunFileError` for a run file that could not be made, and why."""
+    return RunFileError(f"cannot write the run file {path}: {hdf5_reason(error)}{then}")
+
+
+@contextmanager
+def locked(path, key):
+    """Hold the lock of the run file ``path`` (:class:`RunLock`): another process's lock is a
+    :class:`ConfigError` on ``key``, a folder where no lock file can be made a
+    :class:`RunFileError`."""
+    lock = RunLock(path)
+    try:  # released whatever ends the run, a signal inside the taking of the lock included
+        try:
+            lock.__enter__()
+        except FolderBusyError as error:
+            what = "run file" if key == "resume" else "folder"
+            raise ConfigError(key, str(path if key == "resume" else path.parent),
+                              f"a {what} that no other run is using: {error.holder} is "
+                              f"writing {path}; wait for it to end, or choose another") from None
+        except OSError as error:
+            raise cannot_write(path, error) from error
+        yield
+    finally:
+        lock.__exit__()

@@ -1,0 +1,48 @@
+"""SIGINT and SIGTERM as a request to stop a run between compiled chunks."""
+
+import signal
+import threading
+
+
+class Interruption:
+    """SIGINT (Ctrl-C) or SIGTERM (a batch scheduler's time limit) asks the run to stop: the
+    engine finishes its compiled chunk, the runner writes a final snapshot and checkpoint,
+    and the run ends with stop reason ``interrupted`` or ``terminated`` (``resume``
+    continues it). A second signal acts at once: :attr:`at_second_signal` (the command line
+    leaves the process there, as SIGKILL would; by default a KeyboardInterrupt is raised).
+    Installed only in the main thread, and only for the run."""
+
+    REASONS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+    #: ``f(signal)`` called at a second signal; None: raise KeyboardInterrupt
+    at_second_signal = None
+
+    def __init__(self):
+        self.signal = None
+        self._previous = {}
+
+    @property
+    def requested(self):
+        return self.signal is not None
+
+    @property
+    def reason(self):
+        return self.REASONS[self.signal]
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for number in self.REASONS:
+                self._previous[number] = signal.signal(number, self._request)
+        return self
+
+    def _request(self, signum, frame):
+        if self.signal is None:
+            self.signal = signal.Signals(signum)
+        elif Interruption.at_second_signal is not None:
+            Interruption.at_second_signal(signal.Signals(signum))
+        else:
+            raise KeyboardInterrupt
+
+    def __exit__(self, *exc):
+        for number, previous in self._previous.items():
+            signal.signal(number, previous)
+        return False

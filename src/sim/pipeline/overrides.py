@@ -1,0 +1,102 @@
+"""The command line's overrides: integers written as ``2e6`` made whole, a sweep expanded into
+its jobs, configs composed from ``conf/``, and the value of one key read or replaced."""
+
+import itertools
+import math
+import re
+from collections import OrderedDict
+from pathlib import Path
+
+from hydra import compose, initialize_config_dir
+from hydra.core.override_parser.overrides_parser import OverridesParser
+
+from sim.pipeline.cli_exits import fail, first_line
+from sim.pipeline.config import integer_keys
+
+CONF_DIR = str((Path(__file__).resolve().parents[3] / "conf"))
+INTEGER_KEYS = frozenset(integer_keys())
+SWEEP_FLAGS = ("-m", "--multirun")
+
+
+_FLOAT = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def whole_numbers(args):
+    """The command line with numbers written as ``2e6`` or ``1000.0`` given to integer keys
+    (``stop.collisions=2e6``) written as integers; a sweep's comma list item by item."""
+    out = []
+    for arg in args:
+        key, equals, value = arg.partition("=")
+        if equals and key.lstrip("+~") in INTEGER_KEYS:
+            items = [_integer(item.strip()) if _FLOAT.fullmatch(item.strip()) else item
+                     for item in value.split(",")]
+            arg = f"{key}={','.join(items)}"
+        out.append(arg)
+    return out
+
+
+def _integer(text):
+    value = float(text)
+    if math.isfinite(value) and value == int(value) and not re.fullmatch(r"[+-]?\d+", text):
+        return str(int(value))
+    return text
+
+
+def combinations(args):
+    """Every job the command line asks for, as lists of overrides, in the order and numbering
+    of Hydra's basic sweeper (a repeated key: the last one counts)."""
+    overrides = [a for a in args if not a.startswith("-")]
+    try:
+        parsed = OverridesParser.create().parse_overrides(overrides)
+    except Exception as error:
+        fail(first_line(error))
+    choices = OrderedDict()
+    for o in parsed:
+        key = o.get_key_element()
+        if o.is_sweep_override():
+            choices[key] = [f"{key}={v}" for v in o.sweep_string_iterator()]
+        else:
+            choices[key] = [f"{key}={o.get_value_element_as_str()}"]
+    return [list(c) for c in itertools.product(*choices.values())]
+
+
+def compose_overrides(combination, hydra_config=False):
+    """The config of ``combination`` (with Hydra's own node when ``hydra_config``)."""
+    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+        return compose("config", overrides=list(combination),
+                       return_hydra_config=hydra_config)
+
+
+def hydra_settings(args):
+    """The config composed with Hydra's own node, from the command line's ``hydra…``
+    overrides (its folders, launcher, subdir)."""
+    return compose_overrides([a for a in args if a.lstrip("+~").startswith("hydra")],
+                             hydra_config=True)
+
+
+def task_overrides(combination):
+    """``combination`` without its ``hydra…`` overrides."""
+    return [c for c in combination if not c.lstrip("+~").startswith("hydra")]
+
+
+def value_of(args, key):
+    """The value the command line gives ``key`` (the last, as Hydra takes it), unquoted by
+    Hydra's own grammar, or None."""
+    items = [a for a in args if a.partition("=")[0] == key]
+    if not items:
+        return None
+    value = OverridesParser.create().parse_override(items[-1]).value()
+    return None if value is None else str(value)
+
+
+def _quoted(text):
+    """``text`` as a value of Hydra's override grammar."""
+    if re.fullmatch(r"[\w./:+-]+", text):
+        return text
+    return "'" + text.replace("'", "\\'") + "'"
+
+
+def with_value(args, key, value):
+    """The command line with ``key=value`` in place of what it gave ``key``, first (Hydra
+    takes overrides before its flags, such as -m)."""
+    return [f"{key}={_quoted(str(value))}", *(a for a in args if a.partition("=")[0] != key)]

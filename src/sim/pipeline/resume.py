@@ -1,0 +1,217 @@
+"""Resuming a run file from its last checkpoint, and what a stored run must share with a config.
+
+:func:`resume` continues a run file to the same bits as a run never interrupted; it may change
+only the keys of :data:`RESUMABLE`. :func:`stored_config` reads the config a run file records,
+:func:`differences` names the keys in which two configs differ, and :func:`check_consistent`
+refuses a file whose data do not have the sizes its config implies.
+"""
+
+import logging
+import time as wallclock
+from pathlib import Path
+
+import h5py
+import yaml
+from omegaconf import OmegaConf
+from omegaconf.errors import ValidationError
+
+from sim.analysis.observers import from_config as observers_from_config
+from sim.pipeline import resources
+from sim.pipeline.config import ConfigError, SimConfig, flat, validate
+from sim.pipeline.engine_from_config import build_engine
+from sim.pipeline.run_folder import locked
+from sim.pipeline.snapshots import advance, next_snapshot_time
+from sim.pipeline.stop_conditions import already_met, check_reachable
+from sim.pipeline.writing import new_run, open_writer, record
+from sim.storage.errors import RunFileError
+from sim.storage.h5md import read_checkpoint
+from sim.storage.inspect import open_run_file
+
+log = logging.getLogger(__name__)
+
+#: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
+FINISHED = ("collisions", "events", "time", "energy_fraction", "at_rest", "no_events")
+
+#: Keys a resume may change: when the run stops, how often it writes, what it shows.
+RESUMABLE = ("stop.collisions", "stop.events", "stop.time", "stop.energy_fraction",
+             "stop.at_rest", "stop.wall_seconds", "output.every_collisions",
+             "output.every_time", "output.progress")
+
+#: Keys in which a run asked for again into its own folder may differ from the run there:
+#: neither changes what is simulated or written.
+COSMETIC = ("stop.wall_seconds", "output.progress")
+
+
+def differences(stored, cfg, ignore=()):
+    """{key: (value in ``stored``, value in ``cfg``)} for every key in which two configs
+    differ, but those of ``ignore``."""
+    a, b = flat(stored), flat(cfg)
+    return {key: (a.get(key), b.get(key)) for key in sorted({*a, *b})
+            if key not in ignore and a.get(key) != b.get(key)}
+
+
+def describe_differences(differ):
+    """``"key: a there, b here; …"`` of :func:`differences`."""
+    return "; ".join(f"{key}: {a!r} there, {b!r} here" for key, (a, b) in differ.items())
+
+
+def existing_file(path, key):
+    """``path`` as a run file's path: a folder or a missing file is a :class:`ConfigError`."""
+    if not str(path).strip():
+        raise ConfigError(key, str(path), "the path of a run file")
+    path = Path(path)
+    if path.is_dir():
+        inside = path / "run.h5"
+        hint = f" (the run file there is {inside})" if inside.is_file() else ""
+        raise ConfigError(key, str(path), f"a run file, not a folder{hint}")
+    if not path.exists():
+        raise ConfigError(key, str(path), "an existing run file: there is no such file")
+    return path
+
+
+def stored_config(path, key="resume"):
+    """The resolved config and stop reason recorded in the run file ``path``; a file that is
+    missing, a folder, not a run file or damaged is a :class:`ConfigError` on ``key``."""
+    path = existing_file(path, key)
+    try:
+        with open_run_file(path) as f:
+            attrs = f["parameters"].attrs
+            text, reason = str(attrs["config"]), str(attrs["stop_reason"])
+        stored = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(text))
+    except RunFileError as error:
+        raise ConfigError(key, str(path), f"a readable run file: {error}") from error
+    except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
+        raise ConfigError(key, str(path), f"a run file with its config intact: "
+                          f"{type(error).__name__}: {error}") from error
+    return stored, reason
+
+
+def check_consistent(path, cfg, key="resume"):
+    """Refuse (:class:`ConfigError` on ``key``) a run file whose disks, box or checkpoint do
+    not have the sizes its stored config ``cfg`` implies (a config edited in the file)."""
+    n, _ = resources.disk_count(cfg)
+    periodic = cfg.box.boundary == "periodic"
+    try:
+        with open_run_file(path) as f:
+            disks = f["particles/disks"]
+            found = {"disks": disks["radius"].shape[0],
+                     "box": [float(x) for x in disks["box/edges"][()]],
+                     "boundary": [b.decode() for b in disks["box"].attrs["boundary"]]}
+            root = f.get("checkpoint")
+            if root is not None and "latest" in root.attrs:
+                found["checkpointed disks"] = root[root.attrs["latest"]]["disks/table"].shape[0]
+    except (KeyError, OSError, RuntimeError) as error:  # RunFileError is an OSError
+        raise ConfigError(key, str(path), f"a readable run file: "
+                          f"{' '.join(str(error).split())}") from error
+    wanted = {"disks": n, "box": [float(x) for x in cfg.box.size],
+              "boundary": ["periodic" if periodic else "none"] * 2,
+              "checkpointed disks": n}
+    wrong = [f"{name} {found[name]} in the file, {wanted[name]} by its config"
+             for name in found if found[name] != wanted[name]]
+    if wrong:
+        raise ConfigError(key, str(path), f"a run file whose data match its stored config "
+                          f"(edited since the run?): {'; '.join(wrong)}")
+
+
+def resumable(path, overrides=()):
+    """The config ``resume(path, overrides)`` would run, validated, after the checks of the
+    file that need no engine: a run file, not in use, its data of the sizes its config
+    implies, the overrides allowed (:class:`ConfigError`)."""
+    path = existing_file(path, "resume")
+    with locked(path, "resume"):
+        stored, _ = stored_config(path)
+        check_consistent(path, stored)
+    cfg = apply_overrides(stored, list(overrides))
+    validate(cfg)
+    return cfg
+
+
+def resume(path, overrides=()):
+    """Continue the run file at ``path`` from its latest checkpoint, appending to it.
+
+    ``overrides`` (``"key=value"`` strings) may change the keys of :data:`RESUMABLE`: a
+    complete run continues to new stop conditions; the file's config records them. A path
+    that is no run file, a run another process is writing, a checkpoint that does not match
+    its config or stop conditions met already are a :class:`ConfigError` on ``resume`` (or
+    the key), and leave the file as it was."""
+    started = wallclock.perf_counter()
+    path = existing_file(path, "resume")
+    with locked(path, "resume"):
+        stored, reason = stored_config(path)
+        check_consistent(path, stored)
+        return resume_locked(path, stored, reason, list(overrides), started)
+
+
+def apply_overrides(stored, overrides):
+    """``stored`` with ``overrides`` applied; keys outside :data:`RESUMABLE` are refused."""
+    keys = [item.partition("=")[0].lstrip("+~") for item in overrides]
+    fixed = [k for k, key in enumerate(keys) if key not in RESUMABLE]
+    if fixed:
+        raise ConfigError(keys[fixed[0]], overrides[fixed[0]].partition("=")[2],
+                          f"unchanged on resume (it would change what the run file "
+                          f"holds); a resume may change {', '.join(RESUMABLE)}")
+    try:
+        cfg = OmegaConf.merge(stored, OmegaConf.from_dotlist(list(overrides)))
+    except ValidationError as error:
+        raise ConfigError(error.full_key, error.value, str(error.msg).splitlines()[0]) \
+            from error
+    if any(k == "output.every_time" for k in keys) and "output.every_collisions" not in keys:
+        cfg.output.every_collisions = None  # a cadence in time replaces one in collisions
+    if any(k == "output.every_collisions" for k in keys) and "output.every_time" not in keys:
+        cfg.output.every_time = None
+    return cfg
+
+
+def resume_locked(path, stored, reason, overrides, started):
+    """:func:`resume` of ``path`` (config ``stored``, stop reason ``reason``) with its lock
+    held; ``started``: a ``time.perf_counter()`` for the wall-clock budget."""
+    cfg = apply_overrides(stored, overrides)
+    validate(cfg)
+    differ = differences(stored, cfg)
+    recorded = [item for item in overrides if item.partition("=")[0].lstrip("+~") in differ]
+    changed = [item for item in recorded if item.partition("=")[0].lstrip("+~") not in COSMETIC]
+    with h5py.File(path, "r") as f:
+        checkpointed = "checkpoint" in f and "latest" in f["checkpoint"].attrs
+        made_by = yaml.safe_load(str(f["parameters"].attrs.get("overrides", "[]"))) or []
+    if not checkpointed:  # a file of a run that never reached its first checkpoint
+        engine = build_engine(cfg)
+        check_reachable(cfg, engine)
+        path.unlink()
+        return new_run(path, engine, cfg, made_by, started)
+    if reason in FINISHED and not changed:
+        log.info("%s is complete (stopped by %s); nothing to resume", path, reason)
+        return path
+    engine = build_engine(cfg)
+    observers = observers_from_config(cfg, engine)  # they remember the start of the run
+    try:  # read-only: a refusal leaves the file as it was
+        with h5py.File(path, "r") as f:
+            state, last_time, snapshots, slot = read_checkpoint(f)
+        engine.load_state_dict(state)
+    except RunFileError as error:  # both checkpoints damaged
+        raise ConfigError("resume", str(path), "a run file with an intact checkpoint; "
+                          + str(error).partition(": ")[2]) from error
+    except (ValueError, KeyError, OSError) as error:
+        raise ConfigError("resume", str(path), f"a checkpoint that matches its config: "
+                          f"{' '.join(str(error).split())}") from error
+    met = already_met(engine, cfg)
+    if met is not None:
+        keys = [item.partition("=")[0].lstrip("+~") for item in changed]
+        if met[0] in keys:
+            raise ConfigError(*met)
+        if keys:
+            raise ConfigError(keys[0], OmegaConf.select(cfg, keys[0]),
+                              f"a change to a run that is complete ({met[0]}={met[1]} holds "
+                              f"already); raise a stop condition to continue it")
+        log.info("%s is complete; nothing to resume", path)
+        return path
+    check_reachable(cfg, engine)
+    next_snapshot_time(last_time, cfg.output.every_time)
+    writer = open_writer(path, engine, cfg, mode="r+", observers=observers)
+
+    def from_the_checkpoint(interruption):
+        writer.truncate(snapshots, engine.events, slot)
+        writer.record_resume(OmegaConf.to_yaml(cfg, resolve=True), snapshots, recorded)
+        return advance(engine, cfg, writer, last_time, started, interruption)
+
+    record(writer, engine, from_the_checkpoint)
+    return path
