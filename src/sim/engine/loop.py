@@ -15,7 +15,7 @@ Positions are advanced lazily: disk i is stored at ``table[i, X:Y+1]`` at its ow
 zero (its origin kept in ``accumulators[T_ORIGIN]``), so long runs keep full float64
 precision. Stale events are re-predicted, never applied. At large N the loop waits on memory:
 it asks the CPU to prefetch the partner's data and that of the next disks in the queue, and for
-states larger than the caches several events ahead (:func:`prefetch_upcoming`,
+states larger than the caches several events ahead (:func:`sim.engine.lookahead.prefetch_upcoming`,
 :mod:`sim.engine.prefetch`).
 
 Its codes — event partners, statuses, counters and accumulators — and the words for what it
