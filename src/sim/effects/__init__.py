@@ -23,7 +23,7 @@ class Effect:
     cost: tuple  # rows of benchmarks/effects_cost.py (absent, neutral, on)
 
 
-WALL_KEYS = tuple(f"walls.{wall}" for wall in ("left", "right", "bottom", "top"))
+WALL_SECTIONS = tuple(f"walls.{wall}" for wall in ("left", "right", "bottom", "top"))
 
 EFFECTS = (
     Effect("restitution", ("restitution", "wall_restitution", "collapse"),
@@ -34,11 +34,11 @@ EFFECTS = (
     Effect("gravity", ("gravity",), ("gravity",), ("bouncing_ball", "barometric"),
            ("gravity",)),
     Effect("walls", ("wall_motion",),
-           tuple(f"{wall}.{key}" for wall in WALL_KEYS
+           tuple(f"{wall}.{key}" for wall in WALL_SECTIONS
                  for key in ("speed", "amplitude", "frequency")),
            ("piston", "driven_steady_state"), ("moving_walls",)),
     Effect("thermal_walls", ("wall_temperature", "seed"),
-           tuple(f"{wall}.temperature" for wall in WALL_KEYS), ("thermal_walls",),
+           tuple(f"{wall}.temperature" for wall in WALL_SECTIONS), ("thermal_walls",),
            ("thermal_walls",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
            ("test_observers.py::test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots",),

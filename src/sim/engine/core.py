@@ -175,6 +175,8 @@ class Engine(Running, Observables, Checkpoints):
         self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
                                   else float(collapse_interval))
         self.collapse_streak = int(collapse_streak)
+        self.collapse = (CollapseWatch(self.collapse_interval, self.collapse_streak)
+                         if dissipative else None)
         self.stall_dt = stall_interval(min(extent, STALL_RADII * float(radius.min())), box,
                                        self.initial_energy, mass, self.gravity,
                                        self.wall_motion, self.wall_temperature)
@@ -302,12 +304,9 @@ class Engine(Running, Observables, Checkpoints):
 
     def _effects(self):
         """The scene's effects as the compiled loop takes them (:class:`sim.effects.Effects`)."""
-        dissipative = self.restitution is not None or self.wall_restitution is not None
         return Effects(
             restitution=self.restitution, wall_restitution=self.wall_restitution,
-            collapse=(CollapseWatch(self.collapse_interval, self.collapse_streak)
-                      if dissipative else None),
-            tc=self.tc, gravity=self.gravity, wall_motion=self.wall_motion,
+            collapse=self.collapse, tc=self.tc, gravity=self.gravity, wall_motion=self.wall_motion,
             wall_temperature=self.wall_temperature, seed=self.seed, images=self.disks.images,
             virial_tensor=self.virial_tensor,
             event_log=None if self.event_log is None else (self.event_log, self.log_fill))
