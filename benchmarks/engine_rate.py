@@ -58,7 +58,7 @@ def timed_rate(engine, collisions, chunks):
     """Collisions and events per second over ``collisions`` collisions, timed in ``chunks``
     equal parts; also the rate of the fastest part, the engine's speed while the machine
     disturbed it least (timeit's minimum time)."""
-    c0, e0 = engine.collisions, engine.steps
+    c0, e0 = engine.collisions, engine.events
     chunk_rates = []
     seconds = 0.0
     for k in range(1, chunks + 1):
@@ -68,7 +68,7 @@ def timed_rate(engine, collisions, chunks):
         elapsed = time.perf_counter() - started
         seconds += elapsed
         chunk_rates.append((engine.collisions - c_start) / elapsed)
-    return ((engine.collisions - c0) / seconds, (engine.steps - e0) / seconds,
+    return ((engine.collisions - c0) / seconds, (engine.events - e0) / seconds,
             max(chunk_rates))
 
 
@@ -142,7 +142,7 @@ def crater_rows(collisions, seed=1):
                      "n": engine.n, "phi": round(engine.packing_fraction, 3),
                      "collisions_per_s": round(engine.collisions / seconds),
                      "best_chunk_collisions_per_s": None,
-                     "events_per_s": round(engine.steps / seconds),
+                     "events_per_s": round(engine.events / seconds),
                      "bytes_per_disk": round(engine_bytes(engine) / engine.n, 1),
                      "rss_bytes_per_disk": None, "compile_s": None, "reference_ratio": None})
     return rows

@@ -36,7 +36,7 @@ def test_single_disk_traces_tilted_rectangle_for_10000_wall_events():
         expected = [triangle_wave(v[0] * t, radius, 1 - radius),
                     triangle_wave(0.5 - radius + v[1] * t, radius, 1 - radius)]
         np.testing.assert_allclose(engine.positions(t)[0], expected, rtol=0, atol=1e-9)
-    assert engine.wall_collisions == pytest.approx(10_000, abs=1)
+    assert engine.wall_contacts == pytest.approx(10_000, abs=1)
     assert engine.kinetic_energy() == energy
 
 
@@ -170,15 +170,15 @@ def test_renumbering_disks_by_cell_leaves_the_physics_alone():
         b.reorder()
     np.testing.assert_array_equal(a.positions(), b.positions())
     np.testing.assert_array_equal(a.velocities(), b.velocities())
-    np.testing.assert_array_equal(a.collisions_by_disk(), b.collisions_by_disk())
+    np.testing.assert_array_equal(a.contacts_by_disk(), b.contacts_by_disk())
     assert_no_overlap(b)
 
 
 def test_large_systems_renumber_as_they_run():
     engine = gas(25_000, 0.5, (True, True), seed=43)
     energy = engine.kinetic_energy()
-    engine.run(until=lambda e: e.steps >= 3 * e.reorder_every, chunk_events=engine.reorder_every)
-    assert engine.steps == 3 * engine.reorder_every
+    engine.run(until=lambda e: e.events >= 3 * e.reorder_every, chunk_events=engine.reorder_every)
+    assert engine.events == 3 * engine.reorder_every
     cells = engine.disks.cell_of
     assert np.mean(np.diff(cells[cells >= 0]) >= 0) > 0.9  # nearly sorted by cell
     assert engine.kinetic_energy() == pytest.approx(energy, rel=1e-12)
@@ -260,7 +260,7 @@ def test_shells_ahead_of_their_disks_save_exits_and_change_no_physics(periodic):
         engine.run(collisions=4000)
     assert ahead.counters[SHELL_EXITS] < 0.8 * centred.counters[SHELL_EXITS]
     assert ahead.time == pytest.approx(centred.time, rel=1e-12)
-    assert ahead.wall_collisions == centred.wall_collisions
+    assert ahead.wall_contacts == centred.wall_contacts
     d = ahead.positions(centred.time) - centred.positions(centred.time)
     assert np.abs(d - np.round(d) if periodic[0] else d).max() < 1e-9
     assert_no_overlap(ahead)

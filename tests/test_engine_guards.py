@@ -170,7 +170,7 @@ def test_extreme_but_finite_scales_run_clean(radius, side, speed, mass):
     engine = scaled_cluster(radius, (side, side), speed, mass)
     assert engine.grid[0] * engine.grid[1] <= cell_limit(engine.n)
     energy = engine.kinetic_energy()
-    assert engine.run(collisions=3000, until=lambda e: e.steps > 10**6) == "collisions"
+    assert engine.run(collisions=3000, until=lambda e: e.events > 10**6) == "collisions"
     assert engine.kinetic_energy() == pytest.approx(energy, rel=1e-12)
     assert_no_overlap(engine)
 
@@ -182,7 +182,7 @@ def test_disks_slow_against_their_box_do_not_hang_the_queue():
     radius = radius_for_packing(n, 0.2)
     engine = Engine(random_sequential(np.full(n, radius), seed=3), fixed_speed(n, 1e-50, seed=4),
                     radius)
-    assert engine.run(events=2000) == "events"
+    assert engine.run(contacts=2000) == "contacts"
     assert 1e48 < engine.time < 1e52
     assert_no_overlap(engine)
 
@@ -225,15 +225,15 @@ def test_a_chain_creeping_round_a_periodic_box_is_a_stall(options, chunk_events)
     the guard's 16 N + 1000 events, also when they span many chunks."""
     engine = touching_ring(**options)
     with pytest.raises(StalledError, match="TC model") as caught:
-        engine.run(events=10**7, chunk_events=chunk_events)
+        engine.run(contacts=10**7, chunk_events=chunk_events)
     assert "\n" not in str(caught.value)
-    assert engine.steps <= 16 * engine.n + 1001
+    assert engine.events <= 16 * engine.n + 1001
     assert engine.time < 1e-12
 
 
 def test_an_inelastic_chain_without_tc_collapses():
     with pytest.raises(InelasticCollapseError, match="TC model"):
-        touching_ring(restitution=0.5).run(events=10**7)
+        touching_ring(restitution=0.5).run(contacts=10**7)
 
 
 def test_stall_interval_follows_the_fastest_speed_the_scene_sets():
@@ -291,7 +291,7 @@ def test_a_jammed_piston_is_caught_when_the_caller_stops_every_few_collisions():
 def test_an_exhausted_budget_returns_after_one_small_chunk():
     engine = gas(2000, 0.5, seed=7)
     assert engine.run(wall_seconds=0.0, collisions=10**12) == "wall_seconds"
-    assert 0 < engine.steps <= TIMED_FIRST_CHUNK
+    assert 0 < engine.events <= TIMED_FIRST_CHUNK
 
 
 def test_chunks_sized_by_the_clock_change_no_bits():

@@ -64,7 +64,7 @@ def test_queue_stays_consistent(periodic, lookahead):
     engine.lookahead = lookahead
     used = []
     for chunk in range(1, 41):
-        engine.run(events=chunk * 250)
+        engine.run(contacts=chunk * 250)
         used.append(assert_queue_consistent(engine.disks))
     heap_sizes, overflow_sizes = np.array(used).T
     assert heap_sizes.max() > 1 and overflow_sizes.max() > 0

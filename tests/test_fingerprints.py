@@ -28,11 +28,11 @@ def fingerprint(engine):
     """SHA-256 of what a run yields: positions, velocities, times, counts, energies, virials,
     wall positions, and where the engine keeps them, windings and the event log."""
     digest = hashlib.sha256()
-    parts = [engine.positions(), engine.velocities(), engine.collisions_by_disk(),
+    parts = [engine.positions(), engine.velocities(), engine.contacts_by_disk(),
              engine.wall_positions(),
              np.array([engine.time, engine.dissipated_energy, engine.wall_work, engine.virial,
                        engine.kinetic_energy()]),
-             np.array([engine.collisions, engine.wall_collisions])]
+             np.array([engine.collisions, engine.wall_contacts])]
     if engine.virial_tensor is not None:
         parts.append(engine.virial_tensor)
     if engine.event_log is not None:
@@ -80,28 +80,28 @@ def _moving_thermal_walls(seed):
 #: scene name → (engine factory, stop conditions of engine.run)
 ENGINE_SCENES = {
     "periodic_elastic": (lambda: gas(400, 0.3, periodic=(True, True), seed=1),
-                         {"events": 20_000}),
-    "walls_dense": (lambda: gas(400, 0.65, seed=2), {"events": 20_000}),
+                         {"contacts": 20_000}),
+    "walls_dense": (lambda: gas(400, 0.65, seed=2), {"contacts": 20_000}),
     "periodic_inelastic_tc": (lambda: gas(400, 0.3, periodic=(True, True), seed=3,
-                                          restitution=0.8, tc=1e-4), {"events": 20_000}),
+                                          restitution=0.8, tc=1e-4), {"contacts": 20_000}),
     "mixture_walls_inelastic": (lambda: _two_species(300, 4, restitution=[[0.9, 0.8],
                                                                           [0.8, 0.7]],
                                                      wall_restitution=0.9),
-                                {"events": 20_000}),
+                                {"contacts": 20_000}),
     "mixture_periodic": (lambda: _two_species(300, 5, boundary=Boundary(periodic=(True,
                                                                                 True))),
-                         {"events": 20_000}),
+                         {"contacts": 20_000}),
     "gravity_inelastic_tc": (lambda: gas(300, 0.3, seed=6, restitution=0.9,
                                          wall_restitution=0.8, tc=1e-3, gravity=[0.0, -1.0]),
                              {"time": 2.0}),
     "gravity_periodic_x": (lambda: gas(300, 0.3, periodic=(True, False), seed=7,
-                                       gravity=[0.0, -2.0]), {"events": 20_000}),
+                                       gravity=[0.0, -2.0]), {"contacts": 20_000}),
     "moving_thermal_walls": (lambda: _moving_thermal_walls(8), {"time": 3.0}),
     "recorders": (lambda: gas(300, 0.3, periodic=(True, True), seed=9, unwrap=True,
-                              pressure_tensor=True, event_log=1000), {"events": 20_000}),
-    "projectile": (lambda: _projectile(10, restitution=0.9), {"events": 20_000}),
+                              pressure_tensor=True, event_log=1000), {"contacts": 20_000}),
+    "projectile": (lambda: _projectile(10, restitution=0.9), {"contacts": 20_000}),
     "large_lookahead": (lambda: gas(40_000, 0.5, periodic=(True, True), seed=12),
-                        {"events": 100_000}),
+                        {"contacts": 100_000}),
 }
 
 
@@ -133,5 +133,5 @@ def test_engine_scene_keeps_its_bits(name):
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_scenario_keeps_its_bits(name):
     engine = build_engine(compose_scene(name))
-    engine.run(events=5_000)
+    engine.run(contacts=5_000)
     _check(f"scenario/{name}", engine)

@@ -21,7 +21,7 @@ def test_free_flight_is_a_parabola():
         np.testing.assert_allclose(engine.positions(t)[0], r0 + v0 * t + 0.5 * g * t * t,
                                    rtol=0, atol=1e-15)
         np.testing.assert_allclose(engine.velocities(t)[0], v0 + g * t, rtol=0, atol=1e-15)
-    assert engine.run(time=0.38) == "time" and engine.wall_collisions == 0
+    assert engine.run(time=0.38) == "time" and engine.wall_contacts == 0
 
 
 def test_dropped_ball_bounces_to_the_exact_heights():
@@ -34,7 +34,7 @@ def test_dropped_ball_bounces_to_the_exact_heights():
     fall = math.sqrt(2.0 * h0 / G)
     landing = fall
     for k in range(1, 31):
-        engine.run(events=k)
+        engine.run(contacts=k)
         v_k = xi**k * math.sqrt(2.0 * G * h0)
         assert engine.time == pytest.approx(landing, rel=1e-12)
         assert engine.velocities()[0, 1] == pytest.approx(v_k, rel=1e-12)

@@ -328,16 +328,16 @@ def test_numbers_written_as_floats_and_the_largest_seed_run(case, tmp_path):
 # that ends by itself
 
 NEVER = {
-    "single-disk-collisions": ("scenario=single_disk stop.collisions=10 stop.events=null",
+    "single-disk-collisions": ("scenario=single_disk stop.collisions=10 stop.contacts=null",
                                "stop.collisions"),
     "parallel-pair-collisions": ("scenario=two_disks two_disks.velocities=[[0,1],[0,1]] "
                                  "stop.collisions=10", "stop.collisions"),
     "elastic-energy_fraction": ("disks.n=200 stop.collisions=null stop.energy_fraction=0.5",
                                 "stop.energy_fraction"),
-    "periodic-single-disk-events": ("scenario=single_disk box.boundary=periodic "
-                                    "stop.events=100", "stop.events"),
+    "periodic-single-disk-contacts": ("scenario=single_disk box.boundary=periodic "
+                                    "stop.contacts=100", "stop.contacts"),
     "single-disk-collisions-run.dir": ("scenario=single_disk stop.collisions=10 "
-                                       "stop.events=null hydra.run.dir=X", "stop.collisions"),
+                                       "stop.contacts=null hydra.run.dir=X", "stop.collisions"),
     "elastic-energy_fraction-gravity": ("disks.n=50 gravity=[0,-1] stop.collisions=null "
                                         "stop.energy_fraction=0.5", "stop.energy_fraction"),
     "elastic-energy_fraction-thermal-wall": ("disks.n=50 walls.top.temperature=2 "

@@ -54,7 +54,7 @@ def test_free_flight_from_sparse_snapshots_gives_the_dense_ones_between_contacts
     with open_run(runs[scene]) as ds:
         time = ds["time"].values
         position, velocity = ds["position"].values, ds["velocity"].values
-        contacts = ds["collisions"].values + ds["wall_collisions"].values
+        contacts = ds["collisions"].values + ds["wall_contacts"].values
         snapshots = Snapshots(ds)
         gravity, box, periodic = snapshots.gravity, snapshots.box, snapshots.periodic
     assert (gravity is not None) == (scene == "walls_and_gravity")
@@ -155,7 +155,7 @@ def test_a_movie_that_fails_leaves_no_file(runs, tmp_path, monkeypatch):
 def test_frames_across_contacts_are_noted_in_one_line(runs, tmp_path, capsys):
     with open_run(runs["walls_and_gravity"]) as ds:
         time = ds["time"].values
-        gained = np.diff(2 * ds["collisions"].values + ds["wall_collisions"].values)
+        gained = np.diff(2 * ds["collisions"].values + ds["wall_contacts"].values)
     # two frames inside one snapshot interval: one without contacts, then one with a contact
     # (0.5 or more contacts per disk, above the 0.1 that makes the note)
     for k, noted in ((np.flatnonzero(gained == 0)[0], False), (np.flatnonzero(gained)[0], True)):

@@ -174,7 +174,7 @@ def test_event_log_holds_every_contact(tmp_path):
     path = run(cfg, tmp_path)
     log = contacts(path)
     with open_run(path) as ds:
-        events = int(ds["collisions"][-1] + ds["wall_collisions"][-1])
+        events = int(ds["collisions"][-1] + ds["wall_contacts"][-1])
         dissipated = float(ds["dissipated_energy"][-1])
         virial = float(ds["collision_virial"][-1])
         sigma = 2.0 * float(ds["radius"][0])
@@ -205,8 +205,8 @@ def test_event_log_streams_to_the_file_between_snapshots(tmp_path):
     writer.snapshot(engine, 0.0)
     engine.run(collisions=10_000)
     written = writer.file["events/contacts"].shape[0]
-    assert 8_000 <= written <= engine.events
+    assert 8_000 <= written <= engine.contacts
     writer.snapshot(engine)
     writer.flush()
-    assert writer.file["events/contacts"].shape[0] == engine.events
+    assert writer.file["events/contacts"].shape[0] == engine.contacts
     writer.close()

@@ -36,7 +36,7 @@ def compose_scene(name, *overrides):
 
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
-    cfg = compose_scene(name, "stop.collisions=300", "stop.events=1000",
+    cfg = compose_scene(name, "stop.collisions=300", "stop.contacts=1000",
                         "output.every_collisions=null", "output.every_time=2.0")
     path = runner.run(cfg, tmp_path)
     with h5py.File(path, "r") as f:
@@ -51,7 +51,7 @@ def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
             assert frames >= 2 and g["time"].shape == (frames,)
             assert g["value"].shape == (frames, n, 2)
         for name_ in ("kinetic_energy", "kinetic_energy_by_species", "collisions",
-                      "wall_collisions", "dissipated_energy", "collision_virial"):
+                      "wall_contacts", "dissipated_energy", "collision_virial"):
             assert f[f"observables/{name_}/value"].shape[0] == frames
         assert f["parameters"].attrs["stop_reason"] in ("collisions", "events", "time",
                                                         "energy_fraction", "no_events")

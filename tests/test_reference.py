@@ -40,7 +40,7 @@ def compare(position, velocity, radius, periodic, events, strict_events, toleran
             continue  # simultaneous events: compare after the last of them
         t_mid = 0.5 * (t + min(t_next, t + 1.0))
         engine.run(time=t_mid)
-        np.testing.assert_array_equal(engine.collisions_by_disk(), reference.count,
+        np.testing.assert_array_equal(engine.contacts_by_disk(), reference.count,
                                       err_msg=f"event sequences differ at event {k}")
         if k < strict_events:
             d = engine.positions(t_mid) - reference.positions(t_mid)
@@ -49,7 +49,7 @@ def compare(position, velocity, radius, periodic, events, strict_events, toleran
             worst = max(worst, np.abs(d).max(), np.abs(dv).max())
     assert worst < tolerance
     assert engine.collisions == reference.collisions
-    assert engine.wall_collisions == reference.wall_collisions
+    assert engine.wall_contacts == reference.wall_contacts
     assert_no_overlap(engine)
     return worst
 

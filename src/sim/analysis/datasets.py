@@ -5,7 +5,7 @@ Datasets that the figure stages read; nothing here simulates.
 ``disk``, ``axis`` (x, y) and ``species``; variables ``position`` and ``velocity``
 (time, disk, axis) — read lazily from the HDF5 file, so only what is indexed is loaded —
 and the observables (``kinetic_energy``, ``kinetic_energy_by_species``, ``collisions``,
-``wall_collisions``, ``dissipated_energy``, ``collision_virial``, and those of the scene's
+``wall_contacts``, ``dissipated_energy``, ``collision_virial``, and those of the scene's
 observers, e.g. ``radial_distribution`` over ``r``, ``clusters`` over ``disk``,
 ``local_fields`` over ``field`` (``packing_fraction``, ``temperature``), ``y``, ``x``, the
 tensors over ``a``, ``b`` (each ``x``, ``y``)); per-disk coordinates
@@ -16,7 +16,7 @@ the initial state was made (``preparation``), stop reason, box edges and boundar
 parameter as a dimension (``projectile.radius`` → ``projectile_radius``); runs are aligned by
 snapshot number (dim ``snapshot``), their snapshot times kept as a coordinate; a run with
 fewer snapshots than another is padded with NaN, and its integer counters (``collisions``,
-``wall_collisions``) with −1, so that they stay integers; each run's resolved config (YAML),
+``wall_contacts``) with −1, so that they stay integers; each run's resolved config (YAML),
 stop reason and preparation are the variables ``config``, ``stop_reason`` and
 ``preparation``.
 """
@@ -33,7 +33,7 @@ from xarray.core import indexing
 
 from sim.analysis.cells import cell_index, granular_temperature, grid
 from sim.storage.errors import RunFileError
-from sim.storage.h5md import OBSERVABLES
+from sim.storage.h5md import OBSERVABLES, RENAMED_OBSERVABLES
 from sim.storage.inspect import (
     DAMAGE,
     damage_reason,
@@ -118,7 +118,8 @@ def open_run(path):
                     _H5Array(disks[f"{name}/value"], time, path)))
                 for name in ("position", "velocity")}
         axes, damaged = {}, []
-        for name, group in f["observables"].items():
+        for stored, group in f["observables"].items():
+            name = RENAMED_OBSERVABLES.get(stored, stored)
             if name.endswith("by_species"):
                 dims = ("time", "species")
             elif name in OBSERVABLES:

@@ -42,7 +42,7 @@ class ReferenceEngine:
         self.t_disk = np.zeros(n)
         self.count = np.zeros(n, dtype=np.int64)
         self.collisions = 0
-        self.wall_collisions = 0
+        self.wall_contacts = 0
         self.dissipated = 0.0
         self.heap = []
         self._sequence = 0
@@ -165,7 +165,7 @@ class ReferenceEngine:
             self.velocity[i, axis] = -self.xi_wall * u
             self.dissipated += 0.5 * (1.0 - self.xi_wall**2) * self.mass[i] * u**2
             self.count[i] += 1
-            self.wall_collisions += 1
+            self.wall_contacts += 1
             self._predict(i)
         return t, i, j
 

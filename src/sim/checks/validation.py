@@ -341,7 +341,7 @@ def bouncing_ball(restitution=0.8, bounces=30, height=0.5, g=9.81):
                     wall_restitution=restitution, gravity=[0.0, -g])
     worst = 0.0
     for k in range(1, bounces + 1):
-        engine.run(events=k)
+        engine.run(contacts=k)
         speed = restitution**k * math.sqrt(2.0 * g * height)
         peak = engine.positions(engine.time + speed / g)[0, 1] - radius
         worst = max(worst, abs(engine.velocities()[0, 1] / speed - 1.0),

@@ -2,6 +2,8 @@
 user's numbering of the disks, and the contacts its event log kept (:class:`Observables`, a
 part of :class:`sim.engine.core.Engine`)."""
 
+import warnings
+
 import numpy as np
 
 from sim.effects.event_log import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
@@ -9,6 +11,17 @@ from sim.effects.gravity import potential_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
+
+
+def renamed(old, new):
+    """The attribute ``old``, read as ``new`` with a DeprecationWarning (kept for one
+    release after the renaming)."""
+
+    def read(self):
+        warnings.warn(f"Engine.{old} is now Engine.{new}", DeprecationWarning, stacklevel=2)
+        return getattr(self, new)
+
+    return property(read, doc=f"Deprecated name of :attr:`{new}`.")
 
 
 class Observables:
@@ -21,21 +34,27 @@ class Observables:
 
     @property
     def collisions(self):
+        """Disk–disk contacts so far."""
         return int(self.counters[codes.COLLISIONS])
 
     @property
-    def wall_collisions(self):
+    def wall_contacts(self):
+        """Disk–wall contacts so far."""
         return int(self.counters[codes.WALL_CONTACTS])
 
     @property
-    def events(self):
+    def contacts(self):
         """Disk–disk and disk–wall contacts so far."""
-        return self.collisions + self.wall_collisions
+        return self.collisions + self.wall_contacts
 
     @property
-    def steps(self):
-        """Events the engine applied: contacts and neighbour-shell exits."""
+    def events(self):
+        """Events the engine applied so far: contacts and neighbour-shell exits (the words
+        of :mod:`sim.engine.codes`)."""
         return int(self.counters[codes.EVENTS])
+
+    steps = renamed("steps", "events")
+    wall_collisions = renamed("wall_collisions", "wall_contacts")
 
     @property
     def dissipated_energy(self):
@@ -87,10 +106,12 @@ class Observables:
         return np.array([wall_state(self.wall_motion, w, t_abs, self.geometry)[0]
                          for w in range(4)])
 
-    def collisions_by_disk(self):
+    def contacts_by_disk(self):
         """Contacts (disk and wall) of each disk so far: int64[n]."""
         loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
         return self._user_order(self.disks.contacts)
+
+    collisions_by_disk = renamed("collisions_by_disk", "contacts_by_disk")
 
     def next_event_time(self):
         """Absolute time of the next scheduled event (possibly stale)."""

@@ -69,12 +69,13 @@ class Running:
                                              self.time, self.collisions)
             return status
 
-    def run(self, *, events=None, collisions=None, time=None, energy_fraction=None,
-            wall_seconds=None, until=None, chunk_events=200_000):
+    def run(self, *, contacts=None, collisions=None, events=None, time=None,
+            energy_fraction=None, wall_seconds=None, until=None, chunk_events=200_000):
         """Advance until the first stop condition holds; returns its name.
 
-        events : disk and wall contacts since the start of the engine
+        contacts : disk–disk and disk–wall contacts since the start of the engine
         collisions : disk–disk contacts since the start of the engine
+        events : events (contacts and neighbour-shell exits) since the start of the engine
         time : absolute simulated time; the run stops at the last event not after it
         energy_fraction : stop once the kinetic energy is this fraction of the initial one
         wall_seconds : wall-clock budget of this call, checked between chunks, which are then
@@ -88,11 +89,12 @@ class Running:
         The piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended
         it. Chunk sizes change no result: the same inputs give the same bits.
         """
-        if all(x is None for x in (events, collisions, time, energy_fraction, wall_seconds,
-                                   until)):
+        if all(x is None for x in (contacts, collisions, events, time, energy_fraction,
+                                   wall_seconds, until)):
             raise ValueError("run() needs at least one stop condition")
         big = np.iinfo(np.int64).max
-        max_contacts = big if events is None else int(events)
+        max_contacts = big if contacts is None else int(contacts)
+        max_events = big if events is None else int(events)
         max_collisions = big if collisions is None else int(collisions)
         t_stop = math.inf if time is None else float(time)
         closing = t_stop > self.closing_time
@@ -100,19 +102,21 @@ class Running:
         dissipation_limit = (math.inf if energy_fraction is None
                              else self.initial_energy * (1.0 - float(energy_fraction)))
         started = wallclock.perf_counter()
-        reasons = {codes.STATUS_COLLISION_LIMIT: "collisions", codes.STATUS_CONTACT_LIMIT: "events",
-                   codes.STATUS_TIME_REACHED: "time",
+        reasons = {codes.STATUS_COLLISION_LIMIT: "collisions",
+                   codes.STATUS_CONTACT_LIMIT: "contacts", codes.STATUS_TIME_REACHED: "time",
                    codes.STATUS_ENERGY_REACHED: "energy_fraction",
                    codes.STATUS_NO_EVENTS: "no_events"}
         chunk = int(chunk_events) if wall_seconds is None else min(int(chunk_events),
                                                                    TIMED_FIRST_CHUNK)
-        ask_at = self.steps + int(chunk_events)  # where ``until`` is asked next
+        ask_at = self.events + int(chunk_events)  # where ``until`` is asked next
         while True:
             chunk_started = wallclock.perf_counter()
-            steps = self.steps
-            status = self._run_chunk(min(steps + chunk, ask_at), max_contacts, max_collisions,
-                                     t_stop, dissipation_limit)
+            done = self.events
+            status = self._run_chunk(min(done + chunk, ask_at, max_events), max_contacts,
+                                     max_collisions, t_stop, dissipation_limit)
             self._check_piston()
+            if status == codes.STATUS_EVENT_LIMIT and self.events >= max_events:
+                return "events"
             if status != codes.STATUS_EVENT_LIMIT:
                 if closing and status == codes.STATUS_TIME_REACHED:
                     raise ClosedBoxError(
@@ -124,9 +128,9 @@ class Running:
                 now = wallclock.perf_counter()
                 if now - started >= wall_seconds:
                     return "wall_seconds"
-                rate = (self.steps - steps) / max(now - chunk_started, 1e-6)
+                rate = (self.events - done) / max(now - chunk_started, 1e-6)
                 chunk = int(np.clip(rate * TIMED_CHUNK_SECONDS, TIMED_MIN_CHUNK, chunk_events))
-            if self.steps >= ask_at:
+            if self.events >= ask_at:
                 ask_at += int(chunk_events)
                 if until is not None and until(self):
                     return "predicate"

@@ -9,6 +9,7 @@ checks of each scene's own keys, are :data:`sim.pipeline.scenes.SCENES`.
 """
 
 import math
+import warnings
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any, Optional
 
@@ -78,7 +79,8 @@ class TCConfig:
 @dataclass
 class StopConfig:
     collisions: Optional[int] = None
-    events: Optional[int] = None
+    contacts: Optional[int] = None
+    events: Optional[int] = None  # the old name of contacts (RENAMED_KEYS)
     time: Optional[float] = None
     energy_fraction: Optional[float] = None
     at_rest: Optional[float] = None
@@ -176,6 +178,29 @@ class SimConfig:
     scattering: Optional[ScatteringConfig] = None
     two_disks: Optional[TwoDisksConfig] = None
     resume: Optional[str] = None
+
+
+#: Keys renamed in this release: old name → new name. The old name still works, with a
+#: FutureWarning, until the next release.
+RENAMED_KEYS = {"stop.events": "stop.contacts"}
+
+
+def renamed_keys(cfg, warn=True):
+    """Move the values of ``cfg`` (a DictConfig, changed in place) given under an old name of
+    :data:`RENAMED_KEYS` to the new name, where they replace any value (the shipped YAML
+    uses the new names only, so an old name was given on purpose); returns ``cfg``.
+    ``warn``: say so (a FutureWarning); off for the configs stored in run files written
+    before the renaming."""
+    for old, new in RENAMED_KEYS.items():
+        value = OmegaConf.select(cfg, old)
+        if value is None:
+            continue
+        if warn:
+            warnings.warn(f"{old}={value} is now called {new}={value} (the old name goes in "
+                          f"the next release)", FutureWarning)  # one location: said once
+        OmegaConf.update(cfg, new, value)
+        OmegaConf.update(cfg, old, None)
+    return cfg
 
 
 def register():
@@ -310,17 +335,17 @@ def validate(cfg: Any) -> None:
     positive("tc.time", c.tc.time, zero=True)
     _validate_gravity_and_walls(c)
     s = c.stop
-    for key in ("collisions", "events", "time", "wall_seconds"):
+    for key in ("collisions", "contacts", "time", "wall_seconds"):
         positive(f"stop.{key}", s[key])
-    for key in ("collisions", "events"):
+    for key in ("collisions", "contacts"):
         if s[key] is not None and s[key] > MAX_COUNT:
             raise ConfigError(f"stop.{key}", s[key], f"at most 2^62 = {MAX_COUNT}")
     within("stop.energy_fraction", s.energy_fraction, 0.0, 1.0, "between 0 and 1")
     if s.at_rest is not None and not 0.0 < s.at_rest <= 1.0:
         raise ConfigError("stop.at_rest", s.at_rest, "a fraction in (0, 1]")
-    if all(s[k] is None for k in ("collisions", "events", "time", "energy_fraction", "at_rest",
-                                  "wall_seconds")):
-        raise ConfigError("stop", None, "at least one of stop.collisions, stop.events, "
+    if all(s[k] is None for k in ("collisions", "contacts", "time", "energy_fraction",
+                                  "at_rest", "wall_seconds")):
+        raise ConfigError("stop", None, "at least one of stop.collisions, stop.contacts, "
                           "stop.time, stop.energy_fraction, stop.at_rest, stop.wall_seconds")
     o = c.output
     if not o.file or "/" in o.file or o.file.startswith(".") or not o.file.strip():

@@ -92,7 +92,7 @@ def frames(cfg):
             return None, "output.every_time"
         return math.floor(float(s.time) / float(out.every_time)) + 2, "output.every_time"
     cadence = int(out.every_collisions) if out.every_collisions is not None else n
-    bounds = [b for b in (s.collisions, s.events) if b is not None]
+    bounds = [b for b in (s.collisions, s.contacts) if b is not None]
     if not bounds:
         return None, "output.every_collisions"
     return int(min(bounds)) // cadence + 2, "output.every_collisions"
@@ -119,7 +119,7 @@ def estimate(cfg):
         key = frame_key if frame_key != n_key else cadence_key
         file_parts[key] = file_parts.get(key, 0) + count * one_frame
     if cfg.observe.event_log:
-        contacts = cfg.stop.events if cfg.stop.events is not None else cfg.stop.collisions
+        contacts = cfg.stop.contacts if cfg.stop.contacts is not None else cfg.stop.collisions
         if contacts is not None:
             file_parts["observe.event_log"] = LOG_ROW_BYTES * int(contacts)
     return {"memory": (sum(memory.values()), max(memory, key=memory.get)),

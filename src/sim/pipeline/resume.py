@@ -17,7 +17,7 @@ from omegaconf.errors import ValidationError
 
 from sim.analysis.observers import from_config as observers_from_config
 from sim.pipeline import resources
-from sim.pipeline.config import ConfigError, SimConfig, flat, validate
+from sim.pipeline.config import ConfigError, SimConfig, flat, renamed_keys, validate
 from sim.pipeline.engine_from_config import build_engine
 from sim.pipeline.run_folder import locked
 from sim.pipeline.snapshots import advance, next_snapshot_time
@@ -30,12 +30,13 @@ from sim.storage.inspect import open_run_file
 log = logging.getLogger(__name__)
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
-FINISHED = ("collisions", "events", "time", "energy_fraction", "at_rest", "no_events")
+FINISHED = ("collisions", "contacts", "time", "energy_fraction", "at_rest", "no_events",
+            "events")  # "events": the contact stop of run files before its renaming
 
 #: Keys a resume may change: when the run stops, how often it writes, what it shows.
-RESUMABLE = ("stop.collisions", "stop.events", "stop.time", "stop.energy_fraction",
-             "stop.at_rest", "stop.wall_seconds", "output.every_collisions",
-             "output.every_time", "output.progress")
+RESUMABLE = ("stop.collisions", "stop.contacts", "stop.events", "stop.time",
+             "stop.energy_fraction", "stop.at_rest", "stop.wall_seconds",
+             "output.every_collisions", "output.every_time", "output.progress")
 
 #: Keys in which a run asked for again into its own folder may differ from the run there:
 #: neither changes what is simulated or written.
@@ -77,7 +78,8 @@ def stored_config(path, key="resume"):
         with open_run_file(path) as f:
             attrs = f["parameters"].attrs
             text, reason = str(attrs["config"]), str(attrs["stop_reason"])
-        stored = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(text))
+        stored = renamed_keys(OmegaConf.merge(OmegaConf.structured(SimConfig),
+                                              OmegaConf.create(text)), warn=False)
     except RunFileError as error:
         raise ConfigError(key, str(path), f"a readable run file: {error}") from error
     except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
@@ -159,7 +161,7 @@ def apply_overrides(stored, overrides):
         cfg.output.every_collisions = None  # a cadence in time replaces one in collisions
     if any(k == "output.every_collisions" for k in keys) and "output.every_time" not in keys:
         cfg.output.every_time = None
-    return cfg
+    return renamed_keys(cfg)
 
 
 def resume_locked(path, stored, reason, overrides, started):
@@ -209,7 +211,7 @@ def resume_locked(path, stored, reason, overrides, started):
     writer = open_writer(path, engine, cfg, mode="r+", observers=observers)
 
     def from_the_checkpoint(interruption):
-        writer.truncate(snapshots, engine.events, slot)
+        writer.truncate(snapshots, engine.contacts, slot)
         writer.record_resume(OmegaConf.to_yaml(cfg, resolve=True), snapshots, recorded)
         return advance(engine, cfg, writer, last_time, started, interruption)
 

@@ -74,7 +74,7 @@ def advance(engine, cfg, writer, last_time, started, interruption):
                              if x is not None)
             t_stop = min(x for x in (stop.time, next_time, math.inf) if x is not None)
             reason = engine.run(
-                events=stop.events, collisions=None if collisions == math.inf else collisions,
+                contacts=stop.contacts, collisions=None if collisions == math.inf else collisions,
                 time=None if t_stop == math.inf else t_stop,
                 energy_fraction=stop.energy_fraction, wall_seconds=budget(), until=until)
             snapshot_time = t_stop if reason == "time" else None
@@ -82,7 +82,7 @@ def advance(engine, cfg, writer, last_time, started, interruption):
             met = {"collisions": stop.collisions is not None
                    and engine.collisions >= stop.collisions,
                    "time": stop.time is not None and last_time >= stop.time,
-                   "events": True, "energy_fraction": True}.get(reason, False)
+                   "contacts": True, "energy_fraction": True}.get(reason, False)
             if reason in ("time", "no_events") and math.isinf(engine.next_event_time()):
                 # nothing will ever move again: the run is over
                 reason, met = "no_events", True

@@ -36,9 +36,9 @@ def already_met(engine, cfg):
     if s.collisions is not None and engine.collisions >= s.collisions:
         return ("stop.collisions", s.collisions,
                 f"more than the {engine.collisions} collisions the run has made already")
-    if s.events is not None and engine.events >= s.events:
-        return ("stop.events", s.events,
-                f"more than the {engine.events} contacts the run has made already")
+    if s.contacts is not None and engine.contacts >= s.contacts:
+        return ("stop.contacts", s.contacts,
+                f"more than the {engine.contacts} contacts the run has made already")
     if s.time is not None and engine.time >= s.time:
         return ("stop.time", s.time, f"later than t = {engine.time:.6g}, where the run is")
     if s.energy_fraction is not None and \
@@ -109,15 +109,15 @@ def check_reachable(cfg, engine):
     if s.collisions is not None and never_touch:
         why["stop.collisions"] = ("one disk has no other to collide with" if engine.n == 1
                                   else "these disks never touch one another")
-    if s.events is not None and never_touch and np.all(engine.periodic):
-        why["stop.events"] = "a periodic box has no walls and these disks never touch"
+    if s.contacts is not None and never_touch and np.all(engine.periodic):
+        why["stop.contacts"] = "a periodic box has no walls and these disks never touch"
     if s.energy_fraction is not None and s.energy_fraction < 1.0 \
             and not _dissipates(engine, never_touch):
         why["stop.energy_fraction"] = "no contact dissipates energy (elastic disks and walls, " \
                                       "or inelastic disks that never meet)"
     if s.at_rest is not None and _conserves_kinetic_energy(engine) and engine.n_species == 1:
         why["stop.at_rest"] = "the kinetic energy never changes"
-    given = [key for key in ("collisions", "events", "energy_fraction", "at_rest")
+    given = [key for key in ("collisions", "contacts", "energy_fraction", "at_rest")
              if s[key] is not None]
     if given and len(why) == len(given):
         reasons = "; ".join(f"{key}: {text}" for key, text in why.items())

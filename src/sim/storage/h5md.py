@@ -7,7 +7,7 @@ Layout written by :class:`RunWriter`:
   /particles/disks/velocity   the same layout
   /particles/disks/radius, mass, species   time-independent, [N]
   /observables/<name>         step, time, value — kinetic_energy, kinetic_energy_by_species
-                              [T, S], collisions, wall_collisions, dissipated_energy,
+                              [T, S], collisions, wall_contacts, dissipated_energy,
                               collision_virial; and one per observer the scene asks for
                               (:mod:`sim.analysis.observers`): attribute ``dims``, coordinates
                               beside ``value``
@@ -51,13 +51,16 @@ from sim.storage.inspect import DAMAGE
 OBSERVABLES = {
     "kinetic_energy": ("energy", "Σ m v²/2 over all disks"),
     "kinetic_energy_by_species": ("energy", "Σ m v²/2 per species, [species]"),
-    "collisions": ("1", "cumulative disk–disk collisions"),
-    "wall_collisions": ("1", "cumulative disk–wall collisions"),
+    "collisions": ("1", "cumulative disk–disk contacts"),
+    "wall_contacts": ("1", "cumulative disk–wall contacts"),
     "dissipated_energy": ("energy", "cumulative kinetic energy lost in contacts"),
     "collision_virial": ("length × momentum", "cumulative Σ r_ij·Δp_i over disk contacts"),
     "potential_energy": ("energy", "Σ −m g·r (zero without gravity)"),
     "wall_work": ("energy", "cumulative work of moving and thermal walls on the disks"),
 }
+
+#: observables of run files written before a renaming: old name → name now
+RENAMED_OBSERVABLES = {"wall_collisions": "wall_contacts"}
 
 
 def _time_series(group, shape, dtype, unit, description):
@@ -149,6 +152,10 @@ class RunWriter:
             except BaseException:
                 self.abandon()  # a half-made file left open can crash HDF5 at exit
                 raise
+        else:
+            for old, new in RENAMED_OBSERVABLES.items():
+                if old in self.file["observables"]:
+                    self.file["observables"].move(old, new)
         self._flushed_frames = self.file["particles/disks/position/step"].shape[0]
         if engine.event_log is not None:
             engine.event_sink = self._log_contacts
@@ -216,7 +223,7 @@ class RunWriter:
         observables = {"kinetic_energy": engine.kinetic_energy(t),
                        "kinetic_energy_by_species": engine.kinetic_energy_by_species(t),
                        "collisions": engine.collisions,
-                       "wall_collisions": engine.wall_collisions,
+                       "wall_contacts": engine.wall_contacts,
                        "dissipated_energy": engine.dissipated_energy,
                        "collision_virial": engine.virial,
                        "potential_energy": engine.potential_energy(t),
@@ -224,7 +231,7 @@ class RunWriter:
         position, velocity = engine.positions(t), engine.velocities(t)
         for observer in self.observers:
             observables[observer.name] = observer(engine, t, position, velocity)
-        self._frames.append((engine.events, t, position, velocity, observables))
+        self._frames.append((engine.contacts, t, position, velocity, observables))
         if engine.event_log is not None:
             engine.drain_event_log()  # into _log_contacts
         now = wallclock.monotonic()

@@ -107,7 +107,7 @@ class Snapshots:
         inside = np.unique(latest[elapsed > 0.0])
         if not inside.size:
             return 0, 0.0, 0.0
-        contacts = (2.0 * self.ds["collisions"].values + self.ds["wall_collisions"].values)
+        contacts = (2.0 * self.ds["collisions"].values + self.ds["wall_contacts"].values)
         contacts = contacts[self.readable]
         per_disk = (contacts[inside + 1] - contacts[inside]) / self.ds.sizes["disk"]
         interval = self.times[inside + 1] - self.times[inside]
