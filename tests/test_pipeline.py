@@ -53,7 +53,7 @@ def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
         for name_ in ("kinetic_energy", "kinetic_energy_by_species", "collisions",
                       "wall_contacts", "dissipated_energy", "collision_virial"):
             assert f[f"observables/{name_}/value"].shape[0] == frames
-        assert f["parameters"].attrs["stop_reason"] in ("collisions", "events", "time",
+        assert f["parameters"].attrs["stop_reason"] in ("collisions", "contacts", "time",
                                                         "energy_fraction", "no_events")
         assert "scene: " + cfg.scene in f["parameters"].attrs["config"]
         observables = {name_: f[f"observables/{name_}/value"][()] for name_ in
