@@ -78,3 +78,64 @@ def garzo_dufty_temperature_ratio(masses, fractions, restitution):
         return z[0] - z[1]
 
     return brentq(difference, 1e-3, 1e3, xtol=1e-14)
+
+
+def rough_disk_cooling_coefficients(xi, beta, q):
+    """(A, B, C) of the cooling of a dilute gas of equal rough disks (normal restitution ξ,
+    tangential restitution β, I = q m a²; :mod:`sim.effects.rotation`) in the two-temperature
+    Maxwellian approximation (Huthmann & Zippelius, Phys. Rev. E 56, R6275 (1997); Luding,
+    Huthmann, McNamara & Zippelius, Phys. Rev. E 58, 3416 (1998); Santos, arXiv:1803.04290 for
+    disks):
+
+        dT_tr/dt = −ν (A T_tr − B T_rot),   dT_rot/dt = 2ν (B T_tr − C T_rot),
+
+    A = (1 − ξ²)/2 + η(1 − η), B = η²/q, C = (η/q)(1 − η/q), η = q(1 + β)/(2(1 + q)), with
+    ν = :func:`enskog_collision_frequency` at T_tr and T_tr = m⟨v²⟩/2, T_rot = I⟨ω²⟩. The
+    Maxwellian average of the contact rule that gives them is derived in docs/rough-disks.md
+    (in 2D the tangent is one-dimensional and there is one rotational degree of freedom
+    against two translational ones: hence (1 − ξ²)/2 and the factor 2, where 3D has
+    (1 − ξ²)/4 and equal prefactors)."""
+    eta = q * (1.0 + beta) / (2.0 * (1.0 + q))
+    return (0.5 * (1.0 - xi * xi) + eta * (1.0 - eta), eta * eta / q,
+            eta / q * (1.0 - eta / q))
+
+
+def rough_disk_temperature_ratio(xi, beta, q):
+    """r = T_rot/T_tr of the homogeneous cooling state of rough disks, two-temperature
+    Maxwellian approximation (:func:`rough_disk_cooling_coefficients`).
+
+    Both temperatures decay at the same rate: 2(B/r − C) = −(A − B r), the positive root of
+    B r² + (2C − A) r − 2B = 0 (the roots' product is −2). ξ = β = 1 gives r = 1
+    (equipartition) for every q. β = −1 decouples spin (B = C = 0) and the equation leaves
+    r = 0, the spinless state: with ξ < 1 it repels (T_tr decays, T_rot stays), and r → ∞ as
+    β → −1 from above (r ≈ q(1 − ξ²)/(2η²)); at ξ = 1, r → 0 as β → −1 for q < 2.
+
+    Accuracy: the Maxwellian closure ignores the cumulants of the velocity distribution.
+    The Sonine corrections found by Santos and co-workers for disks and spheres change r
+    little over most of the (ξ, β) plane, more as β → −1 (small roughness) where the
+    distribution is far from Maxwellian; docs/rough-disks.md says what was checked here.
+    """
+    a, b, c = rough_disk_cooling_coefficients(xi, beta, q)
+    if b == 0.0:
+        return 0.0
+    s = a - 2.0 * c
+    root = math.sqrt(s * s + 8.0 * b * b)
+    if s >= 0.0:
+        return (s + root) / (2.0 * b)
+    return 4.0 * b / (root - s)  # the same root, free of cancellation
+
+
+def rough_disk_cooling_rate(xi, beta, q):
+    """ζ/ν = A − B r: the decay rate of T_tr (and T_rot) in the homogeneous cooling state of
+    rough disks, dT/dt = −ζ T, per collision frequency ν (:func:`rough_disk_temperature_ratio`);
+    (1 − ξ²)/2 for smooth disks (β = −1, spins at rest)."""
+    a, b, _ = rough_disk_cooling_coefficients(xi, beta, q)
+    return a - b * rough_disk_temperature_ratio(xi, beta, q)
+
+
+def rough_disk_haff_temperature(t, temperature0, collision_frequency0, xi, beta, q):
+    """Haff's law for rough disks in the homogeneous cooling state: ν ∝ √T_tr and
+    dT_tr/dt = −ν (A − B r) T_tr give T_tr(t) = T₀/(1 + t/t₀)², t₀ = 2/(ν₀ (A − B r)) with
+    ν₀ the collision frequency at T₀ (t₀ = 4/((1 − ξ²) ν₀) for smooth disks); T_rot = r T_tr."""
+    t0 = 2.0 / (collision_frequency0 * rough_disk_cooling_rate(xi, beta, q))
+    return temperature0 / (1.0 + np.asarray(t) / t0) ** 2
