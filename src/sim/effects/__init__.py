@@ -62,7 +62,7 @@ EFFECTS = (
                                                  "frequency")),
            ("piston", "driven_steady_state"), ("moving_walls",)),
     Effect("thermal_walls", ("wall_temperature", "seed"),
-           ("seed",) + tuple(f"{wall}.temperature" for wall in WALL_SECTIONS),
+           ("seed", "box.boundary") + tuple(f"{wall}.temperature" for wall in WALL_SECTIONS),
            ("thermal_walls",), ("thermal_walls",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
            ("test_observers.py::test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots",),
