@@ -103,7 +103,8 @@ class Engine(Running, Observables, Checkpoints):
         position = np.where(periodic, position % box, position)
         check_inside(given, position, radius, box, periodic)
 
-        self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
+        with np.errstate(over="ignore"):  # inf for speeds that check_scales refuses below
+            self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
         values = loop_values(effects, {
             "n": n, "n_species": self.n_species, "box": box, "periodic": periodic,
             "radius": radius, "mass": mass, "initial_energy": self.initial_energy})
