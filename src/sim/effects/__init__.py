@@ -4,12 +4,29 @@ effect a scene does not use reaches the loop as None in :class:`Effects`, and nu
 it away.
 
 :data:`EFFECTS` is the one list of them: for each, its module, the fields of
-:class:`Effects` it fills, the config keys that switch it on, the validation rows (studies of
+:class:`Effects` it fills, the config keys it reads, the validation rows (studies of
 :data:`sim.checks.validation.STUDIES`, or tests) that check it, and its rows in
 ``benchmarks/effects_cost.py``. ``tests/test_effect_registry.py`` fails when an effect is
-missing from any of them.
+missing from any of them, or its module lacks a part of the protocol.
+
+The protocol: every effect module defines
+
+``KEYWORDS``
+    {keyword of :class:`sim.engine.core.Engine`: (default, meaning)} — the keywords it takes;
+``check_config(cfg)``
+    raise :class:`sim.pipeline.input_checks.ConfigError` for a bad value of its config keys;
+``engine_arguments(cfg)``
+    its keywords from a validated config, {keyword: value};
+``loop_values(keywords, context)``
+    its fields of :class:`Effects`, {field: value, None when off or neutral}, from every
+    effect's keywords and the ``context``: the scene (n, n_species, box, periodic, radius,
+    mass, initial_energy) and the fields of the effects before it in :data:`EFFECTS`.
+
+The functions below run the protocol over every effect, in the order of :data:`EFFECTS`.
 """
 
+import importlib
+import textwrap
 from collections import namedtuple
 from dataclasses import dataclass
 
@@ -18,9 +35,15 @@ from dataclasses import dataclass
 class Effect:
     name: str  # its module is sim.effects.<name>
     fields: tuple  # fields of Effects it fills (None when off)
-    config: tuple  # keys of conf/config.yaml that switch it on
+    config: tuple  # keys of conf/config.yaml it reads (check_config, engine_arguments)
     validation: tuple  # keys of sim.checks.validation.STUDIES, or tests as "file.py::name"
     cost: tuple  # rows of benchmarks/effects_cost.py (absent, neutral, on)
+
+    @property
+    def module(self):
+        """sim.effects.<name>, imported on first use (the effects import the engine's
+        compiled modules, which import this registry)."""
+        return importlib.import_module(f"{__name__}.{self.name}")
 
 
 WALL_SECTIONS = tuple(f"walls.{wall}" for wall in ("left", "right", "bottom", "top"))
@@ -31,15 +54,16 @@ EFFECTS = (
            ("haff_0.9", "haff_0.8", "mixture_0.8", "bouncing_ball"),
            ("restitution", "wall_restitution", "pair_restitution")),
     Effect("tc", ("tc",), ("tc.time",), ("tc_model",), ("tc",)),
-    Effect("gravity", ("gravity",), ("gravity",), ("bouncing_ball", "barometric"),
-           ("gravity",)),
+    Effect("gravity", ("gravity",), ("gravity", "box.boundary"),
+           ("bouncing_ball", "barometric"), ("gravity",)),
     Effect("walls", ("wall_motion",),
-           tuple(f"{wall}.{key}" for wall in WALL_SECTIONS
-                 for key in ("speed", "amplitude", "frequency")),
+           ("box.boundary",) + tuple(f"{wall}.{key}" for wall in WALL_SECTIONS
+                                     for key in ("temperature", "speed", "amplitude",
+                                                 "frequency")),
            ("piston", "driven_steady_state"), ("moving_walls",)),
     Effect("thermal_walls", ("wall_temperature", "seed"),
-           tuple(f"{wall}.temperature" for wall in WALL_SECTIONS), ("thermal_walls",),
-           ("thermal_walls",)),
+           ("seed", "box.boundary") + tuple(f"{wall}.temperature" for wall in WALL_SECTIONS),
+           ("thermal_walls",), ("thermal_walls",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
            ("test_observers.py::test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots",),
            ("unwrap",)),
@@ -56,3 +80,46 @@ EFFECTS = (
 #: gravity float64[2], wall_motion float64[4, 3], wall_temperature float64[4], seed int,
 #: images int32[n, 2], virial_tensor float64[3], event_log (float64[rows, 6], int64[1]).
 Effects = namedtuple("Effects", [field for effect in EFFECTS for field in effect.fields])
+
+
+def engine_keywords():
+    """{keyword: (default, meaning)} of every effect's Engine keywords."""
+    return {keyword: entry for effect in EFFECTS
+            for keyword, entry in effect.module.KEYWORDS.items()}
+
+
+def keyword_doc(indent="    "):
+    """The effects' Engine keywords as entries of a numpydoc Parameters section."""
+    return "".join(textwrap.fill(f"{keyword} : {meaning}", 92, initial_indent=indent,
+                                 subsequent_indent=2 * indent) + "\n"
+                   for keyword, (_, meaning) in engine_keywords().items())
+
+
+def check_config(cfg):
+    """Every effect's check of its config keys (:class:`ConfigError` on the first bad one)."""
+    for effect in EFFECTS:
+        effect.module.check_config(cfg)
+
+
+def engine_arguments(cfg):
+    """The Engine keywords of every effect from a validated config."""
+    return {keyword: value for effect in EFFECTS
+            for keyword, value in effect.module.engine_arguments(cfg).items()}
+
+
+def loop_values(given, scene):
+    """Every field of :class:`Effects` from the Engine keywords ``given`` (absent ones take
+    their defaults; an unknown one is a TypeError) and the ``scene`` facts of the context."""
+    keywords = engine_keywords()
+    unknown = sorted(set(given) - set(keywords))
+    if unknown:
+        raise TypeError(f"Engine() got unexpected keyword arguments {unknown}; the effects "
+                        f"take {', '.join(keywords)}")
+    keywords = {keyword: given.get(keyword, default)
+                for keyword, (default, _) in keywords.items()}
+    context = dict(scene)
+    values = {}
+    for effect in EFFECTS:
+        values.update(effect.module.loop_values(keywords, context))
+        context.update(values)
+    return values

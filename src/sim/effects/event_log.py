@@ -8,11 +8,37 @@ log stops the loop, which the engine drains and resumes: rows are in engine orde
 engine renames the disks.
 """
 
+import numpy as np
+
 from sim.effects.rules import effect_rule
 
 #: columns of the event log
 LOG_TIME, LOG_DISK, LOG_PARTNER, LOG_IMPULSE, LOG_DISSIPATED, LOG_CONTACT = range(6)
 LOG_COLUMNS = 6
+
+#: rows of the compiled event log between drains when a run logs events (6 float64 each)
+EVENT_LOG_ROWS = 1 << 16
+
+KEYWORDS = {"event_log": (None, "rows buffered in the loop for the log of every contact; None "
+                                "= no log. Full buffers go to :attr:`event_sink` (a callable "
+                                "taking float64[k, 6], e.g. the run file's writer) or else are "
+                                "kept for :meth:`take_event_log`")}
+
+
+def check_config(cfg):
+    """A boolean switch: its type is the schema's."""
+
+
+def engine_arguments(cfg):
+    """:data:`EVENT_LOG_ROWS` when the scene logs events, else None."""
+    return {"event_log": EVENT_LOG_ROWS if cfg.observe.event_log else None}
+
+
+def loop_values(keywords, context):
+    """The empty log (rows, fill), or None."""
+    rows = keywords["event_log"]
+    return {"event_log": None if rows is None
+            else (np.zeros((max(int(rows), 1), LOG_COLUMNS)), np.zeros(1, dtype=np.int64))}
 
 
 def _not_logged(event_log, t_abs, i, partner, impulse, lost, contact):

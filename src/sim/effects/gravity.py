@@ -28,6 +28,35 @@ from numba.extending import overload
 
 from sim.effects.rules import effect_rule
 from sim.engine.kinematics import VX, shell_exit_time, shell_exit_time_accelerated
+from sim.pipeline.input_checks import ConfigError
+
+KEYWORDS = {"gravity": (None, "[gx, gy] uniform acceleration (:mod:`sim.effects.gravity`); "
+                              "None or zero = off")}
+
+
+def check_config(cfg):
+    """gravity two finite numbers, zero in a periodic box."""
+    g = list(cfg.gravity)
+    if len(g) != 2 or not all(math.isfinite(x) for x in g):
+        raise ConfigError("gravity", g, "two finite numbers [gx, gy] (acceleration; [0, 0] = "
+                          "off)")
+    if cfg.box.boundary == "periodic" and any(g):
+        raise ConfigError("gravity", g, "[0, 0] in a periodic box, where nothing stops the "
+                          "fall: use box.boundary=walls")
+
+
+def engine_arguments(cfg):
+    """g of the config."""
+    return {"gravity": list(cfg.gravity)}
+
+
+def loop_values(keywords, context):
+    """g float64[2], None when zero; refused along a periodic axis of the ``context``."""
+    gravity = gravity_vector(keywords["gravity"])
+    if gravity is not None and np.any(gravity[context["periodic"]] != 0.0):
+        raise ValueError(f"gravity {gravity.tolist()} has a component along a periodic "
+                         f"axis, where nothing stops the fall; give it walls")
+    return {"gravity": gravity}
 
 
 def gravity_vector(gravity):

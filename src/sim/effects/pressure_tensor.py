@@ -7,7 +7,26 @@ Liquids*, 2nd ed., §2.4 and §3.7), whose trace is twice the pressure. None whe
 (``observe.pressure_tensor``), and then no code of it is compiled.
 """
 
+import numpy as np
+
 from sim.effects.rules import effect_rule
+
+KEYWORDS = {"pressure_tensor": (False, "accumulate the collision virial tensor Σ r_a Δp_b "
+                                       "(:attr:`virial_tensor`)")}
+
+
+def check_config(cfg):
+    """A boolean switch: its type is the schema's."""
+
+
+def engine_arguments(cfg):
+    """Whether the scene observes the pressure tensor."""
+    return {"pressure_tensor": cfg.observe.pressure_tensor}
+
+
+def loop_values(keywords, context):
+    """The virial tensor float64[3] at zero, or None."""
+    return {"virial_tensor": np.zeros(3) if keywords["pressure_tensor"] else None}
 
 
 def _not_observed(virial_tensor, rx, ry, virial):

@@ -15,12 +15,56 @@ ends the run with :class:`sim.engine.errors.InelasticCollapseError`. The watch k
 each disk's last contact (``t_last``), which the TC model (:mod:`sim.effects.tc`) reads.
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
 
 from sim.effects.rules import effect_rule
 from sim.engine.parameters import per_disk
+from sim.pipeline.input_checks import within
+
+KEYWORDS = {
+    "restitution": (None, "scalar or (s, s) normal restitution ξ per species pair; 1 = elastic"),
+    "wall_restitution": (None, "ξ_w for every wall; 1 = elastic"),
+    "collapse_interval": (None, "inelastic-collapse detector: dissipative contacts of one disk "
+                          "each within this time of the one before make a streak. The default "
+                          "is 1e-6 of the time a disk at the initial rms speed takes to cross "
+                          "its own diameter; in a gas, even a dense one, a run of ten such "
+                          "intervals is far too unlikely ever to be seen, while a collapsing "
+                          "cluster shrinks its intervals geometrically through that scale"),
+    "collapse_streak": (10, "a streak longer than this many contacts is inelastic collapse "
+                            "(:class:`sim.engine.errors.InelasticCollapseError`)"),
+}
+
+
+def check_config(cfg):
+    """restitution.disk and restitution.wall in [0, 1]."""
+    within("restitution.disk", cfg.restitution.disk, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
+    within("restitution.wall", cfg.restitution.wall, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
+
+
+def engine_arguments(cfg):
+    """ξ and ξ_w of the config."""
+    return {"restitution": float(cfg.restitution.disk),
+            "wall_restitution": float(cfg.restitution.wall)}
+
+
+def loop_values(keywords, context):
+    """ξ per species pair, ξ_w, and the collapse watch when either dissipates; its default
+    interval from the scene's initial rms speed and median radius."""
+    restitution = restitution_matrix(keywords["restitution"], context["n_species"])
+    wall_restitution = wall_restitution_value(keywords["wall_restitution"])
+    collapse = None
+    if restitution is not None or wall_restitution is not None:
+        energy, mass = context["initial_energy"], context["mass"]
+        v_rms = math.sqrt(2.0 * energy / mass.sum()) if energy else 1.0
+        crossing_time = 2.0 * float(np.median(context["radius"])) / v_rms
+        interval = keywords["collapse_interval"]
+        collapse = CollapseWatch(1e-6 * crossing_time if interval is None else float(interval),
+                                 int(keywords["collapse_streak"]))
+    return {"restitution": restitution, "wall_restitution": wall_restitution,
+            "collapse": collapse}
 
 
 def restitution_matrix(restitution, n_species):

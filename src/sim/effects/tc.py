@@ -16,6 +16,26 @@ floor under gravity leaves it as from a bounce lasting t_c
 import math
 
 from sim.effects.rules import effect_rule
+from sim.pipeline.input_checks import positive
+
+KEYWORDS = {"tc": (None, "TC-model time t_c (None or 0 = off)")}
+
+
+def check_config(cfg):
+    """tc.time ≥ 0 or null."""
+    positive("tc.time", cfg.tc.time, zero=True)
+
+
+def engine_arguments(cfg):
+    """t_c of the config."""
+    return {"tc": cfg.tc.time}
+
+
+def loop_values(keywords, context):
+    """t_c, None unless a contact dissipates (ξ or ξ_w in ``context``)."""
+    dissipative = (context["restitution"] is not None
+                   or context["wall_restitution"] is not None)
+    return {"tc": tc_time(keywords["tc"], dissipative)}
 
 
 def tc_time(tc, dissipative):

@@ -13,17 +13,55 @@ numbers as one never interrupted.
 """
 
 import math
+import operator
 
 import numpy as np
 from numba import njit
 
 from sim.effects.rules import effect_rule
 from sim.engine.box import WALL_NAMES
+from sim.engine.inputs import WALLS, wall_specs
 from sim.engine.kinematics import INF, VX
+from sim.pipeline.input_checks import positive, walled
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX_2 = np.uint64(0x94D049BB133111EB)
+
+
+KEYWORDS = {"seed": (0, "keys the random draws of thermal walls (same seed, same bits); "
+                        "their temperatures are given with ``walls``")}
+
+
+def check_config(cfg):
+    """Per wall: a temperature > 0 or null, and no thermal wall in a periodic box."""
+    for name in WALLS:
+        temperature = cfg.walls[name].temperature
+        positive(f"walls.{name}.temperature", temperature)
+        if temperature is not None:
+            walled(cfg, name)
+
+
+def engine_arguments(cfg):
+    """The run's seed (the temperatures go with the walls, :mod:`sim.effects.walls`)."""
+    return {"seed": int(cfg.seed)}
+
+
+def loop_values(keywords, context):
+    """T_w per wall (None when no wall is thermal), and the seed."""
+    temperature = wall_temperature(wall_specs(keywords["walls"], context["periodic"]))
+    return {"wall_temperature": temperature, "seed": seed_value(keywords["seed"])}
+
+
+def seed_value(seed):
+    """The seed as the compiled generator takes it (int64 ≥ 0)."""
+    try:
+        value = operator.index(seed)
+    except TypeError:
+        value = None
+    if value is None or not 0 <= value <= np.iinfo(np.int64).max:
+        raise ValueError(f"seed must be an integer in [0, 2**63 - 1], got {seed!r}")
+    return value
 
 
 def wall_temperature(walls):

@@ -7,7 +7,27 @@ side), so that r + images · L is the unwrapped position; otherwise ``images`` i
 loop holds no code for it.
 """
 
+import numpy as np
+
 from sim.effects.rules import effect_rule
+
+KEYWORDS = {"unwrap": (False, "count periodic windings, for :meth:`unwrapped_positions` (mean "
+                              "squared displacements)")}
+
+
+def check_config(cfg):
+    """A boolean switch: its type is the schema's."""
+
+
+def engine_arguments(cfg):
+    """Whether the scene observes mean squared displacements."""
+    return {"unwrap": cfg.observe.mean_squared_displacement}
+
+
+def loop_values(keywords, context):
+    """Winding counts int32[n, 2] at zero, or None."""
+    return {"images": np.zeros((context["n"], 2), dtype=np.int32) if keywords["unwrap"]
+            else None}
 
 
 def _not_counted(images, i, axis, x, folded):

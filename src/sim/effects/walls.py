@@ -24,6 +24,7 @@ from sim.effects.gravity import acceleration, resting_lift
 from sim.effects.rules import effect_rule
 from sim.effects.thermal_walls import thermal_redraw
 from sim.engine.box import SIDE, WALL_NAMES
+from sim.engine.inputs import WALLS, wall_specs
 from sim.engine.kinematics import (
     INF,
     RADIUS,
@@ -33,6 +34,7 @@ from sim.engine.kinematics import (
     first_contact_oscillating,
     wall_contact_time,
 )
+from sim.pipeline.input_checks import ConfigError, positive, walled
 
 #: A piston (a wall moving at constant speed) that has raised the kinetic energy this many
 #: times above max(initial energy, N m U²) has jammed the disks against the opposite wall:
@@ -42,6 +44,43 @@ PISTON_ENERGY_LIMIT = 1e6
 #: A disk within this fraction of the box side of a vibrating wall (a few units of round-off),
 #: and closing, touches it.
 CONTACT_TOLERANCE = 1e-15
+
+KEYWORDS = {"walls": (None, '{"left" | "right" | "bottom" | "top": {"temperature": T_w, '
+                            '"speed": U, "amplitude": A, "frequency": ω}} — thermal, moving and '
+                            "vibrating walls (:mod:`sim.effects.walls`); absent keys keep the "
+                            "wall hard and still")}
+
+
+def check_config(cfg):
+    """Per wall: a finite speed, amplitude and frequency ≥ 0, a frequency for an amplitude,
+    and no moving wall in a periodic box."""
+    for name in WALLS:
+        wall, key = cfg.walls[name], f"walls.{name}"
+        positive(f"{key}.amplitude", wall.amplitude, allow_none=False, zero=True)
+        positive(f"{key}.frequency", wall.frequency, allow_none=False, zero=True)
+        if not math.isfinite(wall.speed):
+            raise ConfigError(f"{key}.speed", wall.speed, "a finite speed")
+        if wall.speed != 0.0 or wall.amplitude != 0.0:
+            walled(cfg, name)
+        if wall.amplitude > 0.0 and wall.frequency == 0.0:
+            raise ConfigError(f"{key}.frequency", wall.frequency,
+                              "an angular frequency > 0 for a wall with an amplitude")
+
+
+def engine_arguments(cfg):
+    """The walls that are not plain hard walls: thermal, moving or vibrating ones."""
+    walls = {}
+    for name in WALLS:
+        wall = cfg.walls[name]
+        if wall.temperature is not None or wall.speed or wall.amplitude:
+            walls[name] = {key: wall[key] for key in wall}
+    return {"walls": walls}
+
+
+def loop_values(keywords, context):
+    """(U, A, ω) per wall, None when no wall moves."""
+    return {"wall_motion": wall_motion(wall_specs(keywords["walls"], context["periodic"]))}
+
 
 def wall_motion(walls):
     """float64[4, 3] of (U, A, ω) per wall for the compiled loop, or None when no wall moves.

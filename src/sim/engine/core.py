@@ -12,16 +12,12 @@ in the original order.
 """
 
 import math
+from dataclasses import fields
 
 import numpy as np
 
-from sim.effects import Effects
-from sim.effects.event_log import LOG_COLUMNS
-from sim.effects.gravity import gravity_vector
-from sim.effects.restitution import CollapseWatch, restitution_matrix, wall_restitution_value
-from sim.effects.tc import tc_time
-from sim.effects.thermal_walls import wall_temperature
-from sim.effects.walls import closing_time, wall_motion
+from sim.effects import Effects, keyword_doc, loop_values
+from sim.effects.walls import closing_time
 from sim.engine import codes
 from sim.engine.checkpoint import Checkpoints
 from sim.engine.inputs import (
@@ -30,8 +26,6 @@ from sim.engine.inputs import (
     check_disks,
     check_inside,
     check_scales,
-    seed_value,
-    wall_specs,
 )
 from sim.engine.kinematics import DISK_COLUMNS, RADIUS, VX, VY, X, Y
 from sim.engine.neighbours import build_all_neighbours, grow_lists, list_starts
@@ -58,6 +52,10 @@ from sim.engine.sizing import (
 )
 from sim.engine.state import DiskArrays
 
+#: fields of :class:`Effects` that are per-disk state: kept in :class:`DiskArrays` (renumbered
+#: and checkpointed with the disks), the others as attributes of :class:`Engine`
+DISK_EFFECTS = tuple(f.name for f in fields(DiskArrays) if f.name in Effects._fields)
+
 
 class Engine(Running, Observables, Checkpoints):
     """Event-driven hard disks in a rectangular box.
@@ -68,9 +66,6 @@ class Engine(Running, Observables, Checkpoints):
     radius, mass : array (n,) or scalar
     species : int array (n,), default all 0
     boundary : :class:`Boundary`
-    restitution : scalar or (s, s) normal restitution ξ per species pair; 1 = elastic
-    wall_restitution : ξ_w for every wall; 1 = elastic
-    tc : TC-model time t_c (None or 0 = off)
     shell : neighbour-shell diameter r_n/σ (default from the packing fraction around the
         disks, :func:`packing_fraction_around_disks`)
     shell_lead : λ in [0, 1): a new shell is centred λ δ ahead of its disk along its
@@ -78,31 +73,14 @@ class Engine(Running, Observables, Checkpoints):
         fraction, :data:`LEAD_TABLE`); changes the cost, never the physics
     list_capacity : initial slots per neighbour list of an ordinary disk (default from the
         expected number of neighbours); full lists grow on demand
-    gravity : [gx, gy] uniform acceleration (:mod:`sim.effects.gravity`); None or zero = off
-    walls : {"left" | "right" | "bottom" | "top": {"temperature": T_w, "speed": U,
-        "amplitude": A, "frequency": ω}} — thermal, moving and vibrating walls
-        (:mod:`sim.effects.walls`); absent keys keep the wall hard and still
-    seed : keys the random draws of thermal walls (same seed, same bits)
-    unwrap : count periodic windings, for :meth:`unwrapped_positions` (mean squared
-        displacements)
-    pressure_tensor : accumulate the collision virial tensor Σ r_a Δp_b
-        (:attr:`virial_tensor`)
-    event_log : rows buffered in the loop for the log of every contact; None = no log. Full
-        buffers go to :attr:`event_sink` (a callable taking float64[k, 6], e.g. the run
-        file's writer) or else are kept for :meth:`take_event_log`
-    collapse_interval, collapse_streak : inelastic-collapse detector: more than
-        ``collapse_streak`` consecutive dissipative contacts of one disk, each within
-        ``collapse_interval`` of the previous one. The default interval is 1e-6 of the time
-        a disk at the initial rms speed takes to cross its own diameter; in a gas, even a
-        dense one, a run of ten such intervals is far too unlikely ever to be seen, while a
-        collapsing cluster shrinks its intervals geometrically through that scale
+
+    The effects' keywords (keyword-only; each effect's ``KEYWORDS``, :mod:`sim.effects`):
+
     """
 
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
-                 boundary=Boundary(), restitution=None, wall_restitution=None, tc=None,
-                 gravity=None, walls=None, seed=0, unwrap=False, pressure_tensor=False,
-                 event_log=None, shell=None, collapse_interval=None, collapse_streak=10,
-                 list_capacity=None, shell_lead=None):
+                 boundary=Boundary(), *, shell=None, list_capacity=None, shell_lead=None,
+                 **effects):
         position = np.array(position, dtype=np.float64, order="C")
         velocity = np.array(velocity, dtype=np.float64, order="C")
         n = position.shape[0]
@@ -125,18 +103,14 @@ class Engine(Running, Observables, Checkpoints):
         position = np.where(periodic, position % box, position)
         check_inside(given, position, radius, box, periodic)
 
-        self.restitution = restitution_matrix(restitution, self.n_species)
-        self.wall_restitution = wall_restitution_value(wall_restitution)
-        dissipative = self.restitution is not None or self.wall_restitution is not None
-        self.tc = tc_time(tc, dissipative)
-        self.gravity = gravity_vector(gravity)
-        if self.gravity is not None and np.any(self.gravity[periodic] != 0.0):
-            raise ValueError(f"gravity {self.gravity.tolist()} has a component along a periodic "
-                             f"axis, where nothing stops the fall; give it walls")
-        by_number = wall_specs(walls, periodic)
-        self.wall_motion = wall_motion(by_number)
-        self.wall_temperature = wall_temperature(by_number)
-        self.seed = seed_value(seed)
+        with np.errstate(over="ignore"):  # inf for speeds that check_scales refuses below
+            self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
+        values = loop_values(effects, {
+            "n": n, "n_species": self.n_species, "box": box, "periodic": periodic,
+            "radius": radius, "mass": mass, "initial_energy": self.initial_energy})
+        disk_effects = {field: values.pop(field) for field in DISK_EFFECTS}
+        for field, value in values.items():
+            setattr(self, field, value)
         # the far edge of the disks, whose ulps bound those of their coordinates (a disk
         # crossing a periodic axis reappears near its far side)
         extent = max(float(box[axis]) if periodic[axis]
@@ -158,35 +132,24 @@ class Engine(Running, Observables, Checkpoints):
         self.accumulators = np.zeros(codes.N_ACCUMULATORS)
         self.pair_collisions = np.zeros((self.n_species, self.n_species), dtype=np.int64)
         self.wall_impulse = np.zeros(4)
-        self.virial_tensor = np.zeros(3) if pressure_tensor else None
-        self.event_log = (None if event_log is None
-                          else np.zeros((max(int(event_log), 1), LOG_COLUMNS)))
-        self.log_fill = np.zeros(1, dtype=np.int64)
         self._logged = []
         self.event_sink = None
-        self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
         self.rebase_every = 16 * n + 1024
         self.reorder_every = (REORDER_EVENTS_PER_DISK * n if n >= REORDER_MIN_DISKS
                               else np.iinfo(np.int64).max)
         self.lookahead = n >= LOOKAHEAD_MIN_DISKS
-
-        v_rms = math.sqrt(2.0 * self.initial_energy / mass.sum()) if self.initial_energy else 1.0
-        crossing_time = 2.0 * float(np.median(radius)) / v_rms
-        self.collapse_interval = (1e-6 * crossing_time if collapse_interval is None
-                                  else float(collapse_interval))
-        self.collapse_streak = int(collapse_streak)
-        self.collapse = (CollapseWatch(self.collapse_interval, self.collapse_streak)
-                         if dissipative else None)
         self.stall_dt = stall_interval(min(extent, STALL_RADII * float(radius.min())), box,
                                        self.initial_energy, mass, self.gravity,
                                        self.wall_motion, self.wall_temperature)
         self.stall_watch = np.array([-math.inf, 0.0])
-        self._build(position, velocity, shell, shell_lead, list_capacity, unwrap,
+        self._build(position, velocity, shell, shell_lead, list_capacity, disk_effects,
                     first_event_time(box, velocity, self.gravity, self.wall_motion))
 
-    def _build(self, position, velocity, shell, lead, list_capacity, unwrap, first_event):
+    def _build(self, position, velocity, shell, lead, list_capacity, disk_effects,
+               first_event):
         """Size shells and cells, allocate the state, link neighbours, schedule events;
-        ``first_event``: :func:`first_event_time`."""
+        ``disk_effects``: the fields of :data:`DISK_EFFECTS`, ``first_event``:
+        :func:`first_event_time`."""
         n, radius, box = self.n, self.radius, self.box
         median = float(np.median(radius))
         big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
@@ -238,7 +201,7 @@ class Engine(Running, Observables, Checkpoints):
             reach_big = radius[big] + delta[big] + reach
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
         self.disks = self._initial_state(position, velocity, radius, delta, is_big, big, cap,
-                                         int(cells[0] * cells[1]), unwrap)
+                                         int(cells[0] * cells[1]), disk_effects)
         self.packing_fraction = phi
         d = self.disks
         # per-disk values every disk shares (None where they differ): the compiled code gets
@@ -277,7 +240,7 @@ class Engine(Running, Observables, Checkpoints):
             self.reorder()
 
     def _initial_state(self, position, velocity, radius, delta, is_big, big, cap, n_cells,
-                       unwrap):
+                       disk_effects):
         """The state arrays before any list is built or event predicted (:mod:`sim.engine.state`);
         its own function, so that the arrays it makes are freed once they are copied into
         the state's buffer."""
@@ -299,17 +262,13 @@ class Engine(Running, Observables, Checkpoints):
             order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
             heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
             big=big.astype(np.int32),
-            cell_head=np.full(n_cells, -1, dtype=np.int32),
-            images=np.zeros((n, 2), dtype=np.int32) if unwrap else None)
+            cell_head=np.full(n_cells, -1, dtype=np.int32), **disk_effects)
 
     def _effects(self):
-        """The scene's effects as the compiled loop takes them (:class:`sim.effects.Effects`)."""
-        return Effects(
-            restitution=self.restitution, wall_restitution=self.wall_restitution,
-            collapse=self.collapse, tc=self.tc, gravity=self.gravity, wall_motion=self.wall_motion,
-            wall_temperature=self.wall_temperature, seed=self.seed, images=self.disks.images,
-            virial_tensor=self.virial_tensor,
-            event_log=None if self.event_log is None else (self.event_log, self.log_fill))
+        """The scene's effects as the compiled loop takes them (:class:`sim.effects.Effects`):
+        the fields of :data:`DISK_EFFECTS` from the disk state, the others from the engine."""
+        return Effects(**{field: getattr(self.disks if field in DISK_EFFECTS else self, field)
+                          for field in Effects._fields})
 
     def _per_disk_parameters(self):
         """Shell radius, mass and species as the compiled loop takes them: the number every
@@ -345,3 +304,6 @@ class Engine(Running, Observables, Checkpoints):
         cell = self.disks.cell_of.astype(np.int64)
         cell[cell < 0] = self.disks.cell_head.size
         self.disks.permute(np.argsort(cell, kind="stable"))
+
+
+Engine.__doc__ = Engine.__doc__.rstrip(" ") + keyword_doc()

@@ -3,7 +3,6 @@ checked before anything is built; a bad one is a ValueError whose one line names
 is allowed."""
 
 import math
-import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -137,14 +136,3 @@ def check_scales(box, radius, mass, velocity, extent, gravity, motion, temperatu
                          f"far edge of the disks ({extent:.3g}; the largest x + R or y + R, the "
                          f"side of a periodic axis): float64 coordinates there cannot resolve "
                          f"its contacts; radii must be at least {RESOLUTION_LIMIT * extent:.3g}")
-
-
-def seed_value(seed):
-    """The thermal walls' seed as the compiled generator takes it (int64 ≥ 0)."""
-    try:
-        value = operator.index(seed)
-    except TypeError:
-        value = None
-    if value is None or not 0 <= value <= np.iinfo(np.int64).max:
-        raise ValueError(f"seed must be an integer in [0, 2**63 - 1], got {seed!r}")
-    return value

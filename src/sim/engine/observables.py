@@ -146,15 +146,16 @@ class Observables:
         """Hand the rows of the compiled log to :attr:`event_sink` (else keep them for
         :meth:`take_event_log`), disks renamed to the user's numbering (the engine's own
         numbering changes when it reorders)."""
-        if self.event_log is None or self.log_fill[0] == 0:
+        if self.event_log is None or self.event_log[1][0] == 0:
             return
-        rows = self.event_log[:self.log_fill[0]].copy()
+        log, fill = self.event_log
+        rows = log[:fill[0]].copy()
         order = self.disks.order
         rows[:, LOG_DISK] = order[rows[:, LOG_DISK].astype(np.int64)]
         partner = rows[:, LOG_PARTNER].astype(np.int64)
         disk = partner >= 0
         rows[disk, LOG_PARTNER] = order[partner[disk]]
-        self.log_fill[0] = 0
+        fill[0] = 0
         if self.event_sink is None:
             self._logged.append(rows)
         else:

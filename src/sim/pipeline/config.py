@@ -3,7 +3,8 @@ the range checks that types cannot express.
 
 Hydra rejects unknown keys and wrong types when it composes the config; :func:`validate`
 then checks every value against what is allowed and raises :class:`ConfigError` naming the
-key, the value and the allowed range. ``conf/config.yaml`` holds the defaults with a comment
+key, the value and the allowed range; each effect checks its own keys
+(:func:`sim.effects.check_config`). ``conf/config.yaml`` holds the defaults with a comment
 on every key; ``conf/scenario/*.yaml`` are the scenarios. The scenes they name, and the
 checks of each scene's own keys, are :data:`sim.pipeline.scenes.SCENES`.
 """
@@ -16,6 +17,7 @@ from typing import Any, Optional
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
+from sim.effects import check_config
 from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.input_checks import (
     LARGEST,
@@ -260,32 +262,6 @@ def _check_numbers(c):
         raise ConfigError("seed", c.seed, f"an integer from 0 to 2^63 − 1 = {MAX_SEED}")
 
 
-def _validate_gravity_and_walls(c):
-    g = list(c.gravity)
-    if len(g) != 2 or not all(math.isfinite(x) for x in g):
-        raise ConfigError("gravity", g, "two finite numbers [gx, gy] (acceleration; [0, 0] = "
-                          "off)")
-    periodic = c.box.boundary == "periodic"
-    if periodic and any(g):
-        raise ConfigError("gravity", g, "[0, 0] in a periodic box, where nothing stops the "
-                          "fall: use box.boundary=walls")
-    for name in ("left", "right", "bottom", "top"):
-        wall = c.walls[name]
-        key = f"walls.{name}"
-        positive(f"{key}.temperature", wall.temperature)
-        positive(f"{key}.amplitude", wall.amplitude, allow_none=False, zero=True)
-        positive(f"{key}.frequency", wall.frequency, allow_none=False, zero=True)
-        if not math.isfinite(wall.speed):
-            raise ConfigError(f"{key}.speed", wall.speed, "a finite speed")
-        moves = wall.speed != 0.0 or wall.amplitude != 0.0 or wall.temperature is not None
-        if moves and periodic:
-            raise ConfigError(f"{key}", OmegaConf.to_container(wall),
-                              "thermal or moving walls need box.boundary=walls")
-        if wall.amplitude > 0.0 and wall.frequency == 0.0:
-            raise ConfigError(f"{key}.frequency", wall.frequency,
-                              "an angular frequency > 0 for a wall with an amplitude")
-
-
 def validate(cfg: Any) -> None:
     """Check every value of a composed config; raise :class:`ConfigError` on the first bad one."""
     c = cfg if isinstance(cfg, DictConfig) else OmegaConf.structured(cfg)
@@ -330,10 +306,7 @@ def validate(cfg: Any) -> None:
             raise ConfigError("disks.packing_fraction", round(phi, 4),
                               f"random placement reaches at most φ ≈ {RSA_JAMMING}; use "
                               f"disks.placement=melted or auto")
-    within("restitution.disk", c.restitution.disk, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
-    within("restitution.wall", c.restitution.wall, 0.0, 1.0, "between 0 and 1 (1 = elastic)")
-    positive("tc.time", c.tc.time, zero=True)
-    _validate_gravity_and_walls(c)
+    check_config(c)  # every effect's keys
     s = c.stop
     for key in ("collisions", "contacts", "time", "wall_seconds"):
         positive(f"stop.{key}", s[key])

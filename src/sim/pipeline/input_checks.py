@@ -1,6 +1,6 @@
 """What a config value may be: :class:`ConfigError`, the limits of the engine's numbers, and
-the checks that :func:`sim.pipeline.config.validate` and the scenes' own checks
-(:mod:`sim.pipeline.scenes`) share."""
+the checks that :func:`sim.pipeline.config.validate`, the effects' (:mod:`sim.effects`) and
+the scenes' own checks (:mod:`sim.pipeline.scenes`) share."""
 
 import numpy as np
 from omegaconf import OmegaConf
@@ -61,6 +61,13 @@ def resolvable(c, key, radius, value=None):
                           f"disks of radius at least 2^-40 of the box's longer "
                           f"side ({SMALLEST_RADIUS * side:.3g} here; this gives "
                           f"{radius:.3g}): float64 positions resolve 2^-52 of the side")
+
+
+def walled(c, name):
+    """Refuse a thermal or moving wall ``walls.<name>`` in a periodic box."""
+    if c.box.boundary == "periodic":
+        raise ConfigError(f"walls.{name}", OmegaConf.to_container(c.walls[name]),
+                          "thermal or moving walls need box.boundary=walls")
 
 
 def pair(c, key, allowed):
