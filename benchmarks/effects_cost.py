@@ -18,6 +18,7 @@ the same round (1.0 = free).
 
 import argparse
 import json
+import math
 import statistics
 import time
 
@@ -46,6 +47,9 @@ EFFECTS = {
     "unwrap": ({"periodic": True}, {}, {"unwrap": False}, {"unwrap": True}),
     "pressure_tensor": ({}, {}, {"pressure_tensor": False}, {"pressure_tensor": True}),
     "event_log": ({}, {}, {"event_log": None}, {"event_log": 1 << 16}),
+    "rotation": ({}, {}, {"tangential_restitution": -1.0}, {"tangential_restitution": 0.5}),
+    "friction": ({"tangential_restitution": 0.5}, {}, {"friction": math.inf},
+                 {"friction": 0.3}),
 }
 
 

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import settings
 
 from sim.checks.audit import outside_box, overlapping_pairs
-from sim.checks.validation import table
+from sim.checks.rows import table
 from sim.engine import Boundary, Engine
 from sim.pipeline.initial import (
     fixed_speed,

@@ -30,10 +30,13 @@ PROTOCOL = ("check_config", "engine_arguments", "loop_values")
 EVERY_EFFECT_ON = ("restitution.disk=0.9", "restitution.wall=0.9", "tc.time=1e-6",
                    "gravity=[0,-1]", "walls.bottom.amplitude=0.01", "walls.bottom.frequency=10",
                    "walls.left.temperature=1", "observe.mean_squared_displacement=true",
-                   "observe.pressure_tensor=true", "observe.event_log=true")
+                   "observe.pressure_tensor=true", "observe.event_log=true",
+                   "restitution.tangential=0.5", "restitution.wall_tangential=0.5",
+                   "friction.mu=0.3", "friction.wall_mu=0.3", "disks.inertia_factor=0.4",
+                   "disks.rotational_temperature=1")
 
 #: sections of conf/config.yaml that the pipeline owns and effects may read too
-PIPELINE_SECTIONS = {"seed", "box", "observe"}
+PIPELINE_SECTIONS = {"seed", "box", "observe", "disks"}
 
 
 def _cost_rows():

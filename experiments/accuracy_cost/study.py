@@ -37,7 +37,8 @@ from scipy import stats
 from sim.analysis.crater import CraterGeometry, crater_overrides
 from sim.analysis.datasets import open_run
 from sim.analysis.theory import enskog_collision_frequency, kolafa_rottner_z
-from sim.checks.validation import block_means, equilibrated_gas, virial_blocks
+from sim.checks.rows import block_means
+from sim.checks.validation import equilibrated_gas, virial_blocks
 from sim.engine import Boundary, Engine, InelasticCollapseError
 from sim.pipeline.initial import (
     fixed_speed,

@@ -3,7 +3,8 @@ Datasets that the figure stages read; nothing here simulates.
 
 ``open_run(path)``: dims ``time`` (one entry per snapshot, coordinate the snapshot time),
 ``disk``, ``axis`` (x, y) and ``species``; variables ``position`` and ``velocity``
-(time, disk, axis) — read lazily from the HDF5 file, so only what is indexed is loaded —
+(time, disk, axis), and ``angular_velocity`` (time, disk) when the disks turn — read lazily
+from the HDF5 file, so only what is indexed is loaded —
 and the observables (``kinetic_energy``, ``kinetic_energy_by_species``, ``collisions``,
 ``wall_contacts``, ``dissipated_energy``, ``collision_virial``, and those of the scene's
 observers, e.g. ``radial_distribution`` over ``r``, ``clusters`` over ``disk``,
@@ -33,7 +34,12 @@ from xarray.core import indexing
 
 from sim.analysis.cells import cell_index, granular_temperature, grid
 from sim.storage.errors import RunFileError
-from sim.storage.h5md import OBSERVABLES, RENAMED_OBSERVABLES
+from sim.storage.h5md import (
+    OBSERVABLES,
+    PARTICLE_SERIES,
+    RENAMED_OBSERVABLES,
+    SPIN_OBSERVABLES,
+)
 from sim.storage.inspect import (
     DAMAGE,
     damage_reason,
@@ -114,15 +120,16 @@ def open_run(path):
         time = snapshot_column(f, "time")
         step = snapshot_column(f, "step")
         n_species = f["observables/kinetic_energy_by_species/value"].shape[1]
-        data = {name: xr.Variable(("time", "disk", "axis"), indexing.LazilyIndexedArray(
-                    _H5Array(disks[f"{name}/value"], time, path)))
-                for name in ("position", "velocity")}
+        data = {name: xr.Variable(("time", "disk", "axis")[:disks[f"{name}/value"].ndim],
+                                  indexing.LazilyIndexedArray(
+                                      _H5Array(disks[f"{name}/value"], time, path)))
+                for name in PARTICLE_SERIES if name in disks}
         axes, damaged = {}, []
         for stored, group in f["observables"].items():
             name = RENAMED_OBSERVABLES.get(stored, stored)
             if name.endswith("by_species"):
                 dims = ("time", "species")
-            elif name in OBSERVABLES:
+            elif name in OBSERVABLES or name in SPIN_OBSERVABLES:
                 dims = ("time",)
             else:  # an observer's: its dims as an attribute, coordinates beside its value
                 dims = ("time", *(str(d) for d in group.attrs["dims"]))

@@ -14,7 +14,6 @@ momentum), lengths in box units.
 
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 from scipy import stats
@@ -27,6 +26,8 @@ from sim.analysis.theory import (
     henderson_z,
     kolafa_rottner_z,
 )
+from sim.checks.rough import rough_cooling, rough_equipartition
+from sim.checks.rows import Check, block_means
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
@@ -37,23 +38,6 @@ from sim.pipeline.initial import (
     random_sequential,
     remove_drift,
 )
-
-
-@dataclass(frozen=True)
-class Check:
-    """One row of the validation table; ``tolerance`` is absolute, on ``measured``."""
-
-    name: str
-    measured: float
-    reference: float
-    tolerance: float
-    source: str
-    seconds: float | None  # wall-clock seconds of the run; None for further rows of one run
-
-    @property
-    def passed(self):
-        return bool(abs(self.measured - self.reference) <= self.tolerance)
-
 
 # -- equilibrium hard-disk fluid --------------------------------------------------------------
 
@@ -72,12 +56,6 @@ def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None
                     boundary=Boundary(periodic=periodic))
     engine.run(collisions=int(collisions_per_disk * n))
     return engine, radius
-
-
-def block_means(values):
-    """Mean and its standard error from independent blocks."""
-    values = np.asarray(values)
-    return float(values.mean()), float(values.std(ddof=1) / math.sqrt(values.size))
 
 
 def virial_blocks(engine, blocks, collisions_per_block):
@@ -485,15 +463,7 @@ STUDIES = {
     "thermal_walls": thermal_walls,
     "driven_steady_state": driven_steady_state,
     "piston": piston,
+    "rough_equipartition": rough_equipartition,
+    **{f"rough_cooling_{xi}_{beta}": (lambda xi=xi, beta=beta: rough_cooling(xi, beta))
+       for xi, beta in ((0.9, 0.5), (0.9, 0.0), (0.8, -0.5), (0.7, 0.5))},
 }
-
-
-def table(rows):
-    """The rows as a Markdown table."""
-    lines = ["| check | measured | reference | tolerance | pass | seconds | source |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
-    for r in rows:
-        lines.append(f"| {r.name} | {r.measured:.6g} | {r.reference:.6g} | ± {r.tolerance:.2g} | "
-                     f"{'pass' if r.passed else 'FAIL'} | "
-                     f"{'same run' if r.seconds is None else f'{r.seconds:.1f}'} | {r.source} |")
-    return "\n".join(lines) + "\n"

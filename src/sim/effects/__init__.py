@@ -72,13 +72,21 @@ EFFECTS = (
            ("pressure_tensor",)),
     Effect("event_log", ("event_log",), ("observe.event_log",),
            ("test_observers.py::test_event_log_holds_every_contact",), ("event_log",)),
+    Effect("rotation", ("roughness", "friction", "spin"),
+           ("restitution.tangential", "restitution.wall_tangential", "friction.mu",
+            "friction.wall_mu", "disks.inertia_factor", "disks.rotational_temperature"),
+           ("rough_equipartition", "rough_cooling_0.9_0.5", "rough_cooling_0.9_0.0",
+            "rough_cooling_0.8_-0.5", "rough_cooling_0.7_0.5"),
+           ("rotation", "friction")),
 )
 
 #: The effects of a scene as the compiled loop takes them, one field per entry of the
 #: effects' ``fields``, None when off: restitution float64[s, s] (ξ per species pair),
 #: wall_restitution float, collapse :class:`sim.effects.restitution.CollapseWatch`, tc float,
 #: gravity float64[2], wall_motion float64[4, 3], wall_temperature float64[4], seed int,
-#: images int32[n, 2], virial_tensor float64[3], event_log (float64[rows, 6], int64[1]).
+#: images int32[n, 2], virial_tensor float64[3], event_log (float64[rows, 6], int64[1]),
+#: roughness :class:`sim.effects.rotation.Roughness`, friction
+#: :class:`sim.effects.rotation.Friction`, spin float64[n].
 Effects = namedtuple("Effects", [field for effect in EFFECTS for field in effect.fields])
 
 
@@ -108,8 +116,9 @@ def engine_arguments(cfg):
 
 
 def loop_values(given, scene):
-    """Every field of :class:`Effects` from the Engine keywords ``given`` (absent ones take
-    their defaults; an unknown one is a TypeError) and the ``scene`` facts of the context."""
+    """(every field of :class:`Effects`, every effect keyword) from the Engine keywords
+    ``given`` (absent ones take their defaults; an unknown one is a TypeError) and the
+    ``scene`` facts of the context."""
     keywords = engine_keywords()
     unknown = sorted(set(given) - set(keywords))
     if unknown:
@@ -122,4 +131,4 @@ def loop_values(given, scene):
     for effect in EFFECTS:
         values.update(effect.module.loop_values(keywords, context))
         context.update(values)
-    return values
+    return values, keywords

@@ -33,22 +33,173 @@ the virial of :func:`sim.engine.contact.collide_disks` divided by |r_ij| = a_i +
 (1 + ξ_w) m |v_n − u| at a wall, the absolute momentum :func:`sim.effects.walls.hit_wall`
 gives the wall. Call these functions only after a normal impulse was applied (v_n < 0).
 
-``friction`` is μ_f, or None without friction; then no code of it is compiled
-(:mod:`sim.effects.rules`). ``spin`` is float64[n], updated in place like the disk table
+As an effect of a scene (:mod:`sim.effects`): ``roughness`` = :class:`Roughness` (q, β per
+species pair, β_w per wall), or None for smooth disks, and then no code of rotation is
+compiled; ``friction`` = :class:`Friction` (μ_f per species pair and per wall, inf where a
+contact has no friction limit), or None; ``spin`` float64[n] in the disk state, or None when
+no disk turns. Thermal walls (:mod:`sim.effects.thermal_walls`) redraw the velocity of a
+leaving disk and leave its spin alone.
+
+In the contact functions, ``friction`` is μ_f, or None without friction; then no code of it
+is compiled (:mod:`sim.effects.rules`). ``spin`` is float64[n], updated in place like the disk table
 (columns in :mod:`sim.engine.kinematics`). The derivation of the signs, the wall case and the
 theory of cooling rough disks (:mod:`sim.analysis.theory`) are in docs/rough-disks.md.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from sim.effects.rules import effect_rule
+from sim.effects.thermal_walls import is_thermal
 from sim.engine.kinematics import RADIUS, VX, VY
+from sim.pipeline.input_checks import ConfigError, positive, within
 
 #: The tangential restitution of a smooth contact: no tangential impulse.
 SMOOTH = -1.0
+
+#: Seed offset of the initial spins' generator (apart from every other draw of the seed)
+SPIN_STREAM = 0x5EED5
+
+KEYWORDS = {
+    "tangential_restitution": (None, "scalar or (s, s) tangential restitution β per species "
+                               "pair in [−1, 1] (β₀ of Walton's model with friction): −1 = "
+                               "smooth, 1 = perfectly rough"),
+    "wall_tangential_restitution": (None, "β_w in [−1, 1], one for every wall or [4] (left, "
+                                    "right, bottom, top); −1 = smooth"),
+    "friction": (None, "scalar or (s, s) Coulomb friction coefficient μ_f ≥ 0 per species "
+                 "pair (Walton's model); None = constant β"),
+    "wall_friction": (None, "μ_f of the walls, one or [4]; None = constant β_w"),
+    "inertia_factor": (0.5, "q of the moment of inertia I = q m a² (1/2 uniform disk, 1 ring)"),
+    "spin": (None, "initial angular velocities ω float64[n] (counter-clockwise positive); "
+                   "default all 0"),
+    "rotational_temperature": (0.0, "initial spins drawn from the Maxwellian at this T_rot = "
+                               "⟨I ω²⟩ (keyed by ``seed``), instead of ``spin``"),
+}
+
+
+class Roughness(NamedTuple):
+    """Rough contacts as the compiled loop takes them."""
+    q: float  # I = q m a²
+    beta: np.ndarray  # float64[s, s], β (β₀ with friction) per species pair
+    beta_wall: np.ndarray  # float64[4], per wall
+
+
+class Friction(NamedTuple):
+    """Walton's friction as the compiled loop takes it; inf: no limit (constant β)."""
+    mu: np.ndarray  # float64[s, s]
+    mu_wall: np.ndarray  # float64[4]
+
+
+def check_config(cfg):
+    """β and β_w in [−1, 1], μ_f ≥ 0 or null, with a β₀ that can stick; q in (0, 1];
+    T_rot ≥ 0."""
+    r, f = cfg.restitution, cfg.friction
+    allowed = "between −1 (smooth) and 1 (perfectly rough)"
+    within("restitution.tangential", r.tangential, -1.0, 1.0, allowed)
+    within("restitution.wall_tangential", r.wall_tangential, -1.0, 1.0, allowed)
+    positive("friction.mu", f.mu, zero=True)
+    positive("friction.wall_mu", f.wall_mu, zero=True)
+    for mu, beta, key in ((f.mu, r.tangential, "restitution.tangential"),
+                          (f.wall_mu, r.wall_tangential, "restitution.wall_tangential")):
+        if mu is not None and beta == SMOOTH:
+            raise ConfigError(key, beta, "β₀ > −1 with friction (β₀ = −1 never sticks: "
+                                         "the contact stays smooth whatever μ_f)")
+    q = cfg.disks.inertia_factor
+    if not 0.0 < q <= 1.0:
+        raise ConfigError("disks.inertia_factor", q, "q = I/(m a²) in (0, 1] (1/2 uniform "
+                                                     "disk, 1 ring)")
+    positive("disks.rotational_temperature", cfg.disks.rotational_temperature, zero=True)
+
+
+def engine_arguments(cfg):
+    """β, β_w, μ_f, the walls' μ_f, q and the initial T_rot of the config."""
+    r, f = cfg.restitution, cfg.friction
+    return {"tangential_restitution": float(r.tangential),
+            "wall_tangential_restitution": float(r.wall_tangential),
+            "friction": f.mu, "wall_friction": f.wall_mu,
+            "inertia_factor": float(cfg.disks.inertia_factor),
+            "rotational_temperature": float(cfg.disks.rotational_temperature)}
+
+
+def _pairs(value, n_species, default, name):
+    matrix = np.array(np.broadcast_to(np.asarray(default if value is None else value,
+                                                 dtype=np.float64), (n_species, n_species)))
+    if not np.array_equal(matrix, matrix.T):
+        raise ValueError(f"{name} matrix must be symmetric, got {matrix.tolist()}")
+    return matrix
+
+
+def _walls(value, default):
+    return np.array(np.broadcast_to(np.asarray(default if value is None else value,
+                                               dtype=np.float64), (4,)))
+
+
+def loop_values(keywords, context):
+    """Roughness, friction and the spins (None when every contact is smooth and no disk
+    turns); the initial spins from ``spin`` or drawn at ``rotational_temperature``."""
+    s = context["n_species"]
+    beta = _pairs(keywords["tangential_restitution"], s, SMOOTH, "tangential_restitution")
+    beta_wall = _walls(keywords["wall_tangential_restitution"], SMOOTH)
+    mu = _pairs(keywords["friction"], s, math.inf, "friction")
+    mu_wall = _walls(keywords["wall_friction"], math.inf)
+    q = float(keywords["inertia_factor"])
+    for value in (*beta.ravel(), *beta_wall):
+        rough_parameters(value, None, q)
+    for value in (*mu.ravel(), *mu_wall):
+        if not value >= 0.0:
+            raise ValueError(f"friction coefficient must be ≥ 0, got {value}")
+    rough = bool(np.any(beta > SMOOTH) or np.any(beta_wall > SMOOTH))
+    spin = initial_spins(keywords, context, q)
+    if not rough and not np.any(spin):
+        return {"roughness": None, "friction": None, "spin": None}
+    return {"roughness": Roughness(q, beta, beta_wall) if rough else None,
+            "friction": (Friction(mu, mu_wall) if rough and np.isfinite([*mu.ravel(),
+                                                                          *mu_wall]).any()
+                         else None),
+            "spin": spin}
+
+
+def initial_spins(keywords, context, q):
+    """float64[n]: ``spin`` as given, or Maxwellian at ``rotational_temperature`` (keyed by
+    ``seed``; zero at T = 0)."""
+    n, temperature = context["n"], float(keywords["rotational_temperature"])
+    if keywords["spin"] is not None:
+        if temperature:
+            raise ValueError("give the initial spins or a rotational temperature, not both")
+        spin = np.array(np.broadcast_to(np.asarray(keywords["spin"], dtype=np.float64), (n,)))
+        if not np.all(np.isfinite(spin)):
+            raise ValueError("initial spins must be finite")
+        return spin
+    if not 0.0 <= temperature < math.inf:
+        raise ValueError(f"rotational_temperature must be finite and ≥ 0, got {temperature}")
+    if not temperature:
+        return np.zeros(n)
+    inertia = moment_of_inertia(q, context["mass"], context["radius"])
+    rng = np.random.default_rng([int(keywords["seed"]), SPIN_STREAM])
+    return maxwellian_spins(rng, temperature, inertia)
+
+
+def _no_friction(friction, s_i, s_j):
+    return None
+
+
+@effect_rule(_no_friction)
+def friction_of(friction, s_i, s_j):
+    """μ_f of a contact between species s_i and s_j."""
+    return friction.mu[s_i, s_j]
+
+
+def _no_wall_friction(friction, wall):
+    return None
+
+
+@effect_rule(_no_wall_friction)
+def wall_friction_of(friction, wall):
+    """μ_f of a contact with ``wall``."""
+    return friction.mu_wall[wall]
 
 
 def _constant_beta(friction, beta, m_t, g_t, normal_impulse):
@@ -182,3 +333,40 @@ def maxwellian_spins(rng, temperature, inertia):
     so that ⟨I ω²⟩ = T. ``rng`` a numpy Generator, ``inertia`` float64[n]."""
     inertia = np.asarray(inertia, dtype=float)
     return rng.normal(0.0, 1.0, inertia.shape) * np.sqrt(temperature / inertia)
+
+
+def _smooth_disks(roughness, friction, spin, tc, i, j, rx, ry, normal_impulse, t, t_last,
+                  s_i, s_j, disks, m_i, m_j):
+    return 0.0
+
+
+@effect_rule(_smooth_disks)
+def rough_collision(roughness, friction, spin, tc, i, j, rx, ry, normal_impulse, t, t_last,
+                    s_i, s_j, disks, m_i, m_j):
+    """The tangential part of the collision of disks i and j (species s_i, s_j) at time t,
+    at separation r = r_i − r_j, after a normal impulse P_n (zero: no contact, nothing to
+    do), with the TC model's choice (:func:`tc_roughness`). Returns the energy lost."""
+    if normal_impulse <= 0.0:
+        return 0.0
+    beta = tc_roughness(tc, roughness.beta[s_i, s_j], t, t_last[i], t_last[j])
+    inverse_r = 1.0 / math.sqrt(rx * rx + ry * ry)
+    return rough_contact(i, j, rx * inverse_r, ry * inverse_r, normal_impulse, disks, spin,
+                         m_i, m_j, roughness.q, beta, friction_of(friction, s_i, s_j))
+
+
+def _smooth_wall(roughness, friction, spin, tc, temperature, i, wall, impulse, t, t_last,
+                 disks, m):
+    return 0.0
+
+
+@effect_rule(_smooth_wall)
+def rough_wall_contact(roughness, friction, spin, tc, temperature, i, wall, impulse, t,
+                       t_last, disks, m):
+    """The tangential part of disk i's contact with ``wall`` at time t, after the wall gave
+    it the momentum ``impulse`` along its axis (zero: no contact); a thermal wall
+    (``temperature``) redraws the velocity and keeps the spin. Returns the energy lost."""
+    if impulse == 0.0 or is_thermal(temperature, wall):
+        return 0.0
+    beta = tc_roughness(tc, roughness.beta_wall[wall], t, t_last[i], t_last[i])
+    return rough_wall(i, wall, abs(impulse), disks, spin, m, roughness.q, beta,
+                      wall_friction_of(friction, wall))

@@ -103,6 +103,16 @@ def contact_key(temperature, seed, contact):
     return _splitmix64(np.uint64(seed) ^ _splitmix64(np.uint64(contact)))
 
 
+def _no_thermal_wall(temperature, wall):
+    return False
+
+
+@effect_rule(_no_thermal_wall)
+def is_thermal(temperature, wall):
+    """Whether ``wall`` is thermal."""
+    return temperature[wall] == temperature[wall]  # NaN: not thermal
+
+
 def _not_thermal(temperature, key, wall, u, sign, m, disks, i, v_n, v_t):
     return False, 0.0, 0.0
 

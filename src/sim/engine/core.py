@@ -105,7 +105,7 @@ class Engine(Running, Observables, Checkpoints):
 
         with np.errstate(over="ignore"):  # inf for speeds that check_scales refuses below
             self.initial_energy = float(np.sum(0.5 * mass * np.sum(velocity**2, axis=1)))
-        values = loop_values(effects, {
+        values, self.effect_keywords = loop_values(effects, {
             "n": n, "n_species": self.n_species, "box": box, "periodic": periodic,
             "radius": radius, "mass": mass, "initial_energy": self.initial_energy})
         disk_effects = {field: values.pop(field) for field in DISK_EFFECTS}
@@ -144,6 +144,7 @@ class Engine(Running, Observables, Checkpoints):
         self.stall_watch = np.array([-math.inf, 0.0])
         self._build(position, velocity, shell, shell_lead, list_capacity, disk_effects,
                     first_event_time(box, velocity, self.gravity, self.wall_motion))
+        self.initial_energy += self.rotational_energy()
 
     def _build(self, position, velocity, shell, lead, list_capacity, disk_effects,
                first_event):

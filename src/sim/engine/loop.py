@@ -37,6 +37,7 @@ from sim.effects.event_log import log_contact
 from sim.effects.gravity import shell_exit
 from sim.effects.pressure_tensor import add_virial_tensor
 from sim.effects.restitution import collapsing, disk_restitution, wall_restitution_of
+from sim.effects.rotation import rough_collision, rough_wall_contact
 from sim.effects.tc import tc_restitution
 from sim.effects.thermal_walls import contact_key
 from sim.effects.walls import hit_wall, predict_wall_contact
@@ -182,11 +183,15 @@ def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
     ry = minimum_image(table[i, Y] - table[j, Y], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
     xi = tc_restitution(effects.tc, disk_restitution(effects.restitution, disks.species, i, j),
                         t, t_last[i], t_last[j])
-    lost, virial = collide_disks(i, j, rx, ry, xi, table, per_disk(disks.mass, i),
-                                 per_disk(disks.mass, j))
+    m_i = per_disk(disks.mass, i)
+    m_j = per_disk(disks.mass, j)
+    lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j)
     add_virial_tensor(effects.virial_tensor, rx, ry, virial)
     s_i = per_disk(disks.species, i)
     s_j = per_disk(disks.species, j)
+    lost += rough_collision(effects.roughness, effects.friction, effects.spin, effects.tc, i, j,
+                            rx, ry, virial / (table[i, RADIUS] + table[j, RADIUS]), t, t_last,
+                            s_i, s_j, table, m_i, m_j)
     tallies.pair_collisions[min(s_i, s_j), max(s_i, s_j)] += 1
     disks.coll_count[i] += 1
     disks.coll_count[j] += 1
@@ -208,9 +213,13 @@ def touch_wall(i, wall, t, t_origin, disks, box, effects, tallies, wall_contacts
     xi_w = tc_restitution(effects.tc, wall_restitution_of(effects.wall_restitution), t,
                           t_last[i], t_last[i])
     key = contact_key(effects.wall_temperature, effects.seed, wall_contacts)
-    lost, impulse, work = hit_wall(i, wall, t_origin + t, xi_w, disks.table,
-                                   per_disk(disks.mass, i), box.geometry, effects.wall_motion,
-                                   effects.wall_temperature, key, effects.gravity, effects.tc)
+    m = per_disk(disks.mass, i)
+    lost, impulse, work = hit_wall(i, wall, t_origin + t, xi_w, disks.table, m, box.geometry,
+                                   effects.wall_motion, effects.wall_temperature, key,
+                                   effects.gravity, effects.tc)
+    lost += rough_wall_contact(effects.roughness, effects.friction, effects.spin, effects.tc,
+                               effects.wall_temperature, i, wall, impulse, t, t_last,
+                               disks.table, m)
     tallies.wall_impulse[wall] += impulse
     disks.coll_count[i] += 1
     log_full = log_contact(effects.event_log, t_origin + t, i, -1 - wall, abs(impulse), lost,

@@ -8,6 +8,7 @@ import numpy as np
 
 from sim.effects.event_log import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
 from sim.effects.gravity import potential_energy
+from sim.effects.rotation import moment_of_inertia, rotational_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
@@ -125,9 +126,32 @@ class Observables:
         return np.bincount(d.species, weights=energy, minlength=self.n_species)
 
     def kinetic_energy(self, t=None):
-        """Σ m v²/2 at time t (default: the last event)."""
+        """Translational kinetic energy Σ m v²/2 at time t (default: the last event); the
+        rotational part is :meth:`rotational_energy`."""
         d = self.disks
         return float(np.sum(0.5 * d.mass * np.sum(self._state(t)[1] ** 2, axis=1)))
+
+    @property
+    def spinning(self):
+        """Whether disks turn (:mod:`sim.effects.rotation`): rough contacts, or spins given."""
+        return self.disks.spin is not None
+
+    def angular_velocities(self):
+        """Spins ω float64[n] (counter-clockwise positive; constant between contacts), zero
+        when no disk turns."""
+        if not self.spinning:
+            return np.zeros(self.n)
+        return self._user_order(self.disks.spin)
+
+    def moments_of_inertia(self):
+        """I = q m a² float64[n] (q: ``inertia_factor``)."""
+        return moment_of_inertia(self.effect_keywords["inertia_factor"], self.mass, self.radius)
+
+    def rotational_energy(self):
+        """Σ I ω²/2 (zero when no disk turns)."""
+        if not self.spinning:
+            return 0.0
+        return rotational_energy(self.angular_velocities(), self.moments_of_inertia())
 
     def potential_energy(self, t=None):
         """Σ −m g·r at time t (zero without gravity)."""

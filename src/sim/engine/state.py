@@ -17,6 +17,8 @@ Per-disk arrays (n disks, engine order):
   nb_start int32[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
   cell_next, cell_prev, cell_of int32[n] — cell lists; order int32[n] — original index;
   images int32[n, 2] — periodic windings (:mod:`sim.engine.flight`), or None when not counted.
+  spin float64[n] — angular velocities (:mod:`sim.effects.rotation`), or None when no disk
+  turns.
 Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
 calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells].
 
@@ -35,6 +37,8 @@ from sim.engine.queue import NEXT, PREV
 PER_DISK = ("table", "delta", "mass", "species", "is_big", "coll_count", "contacts", "t_last",
             "streak", "event_time", "event_partner", "event_count", "links", "nb_start", "nb_cap",
             "nb_count", "cell_next", "cell_prev", "cell_of", "order")
+#: per-disk arrays of effects, None when the effect is off
+OPTIONAL_PER_DISK = ("images", "spin")
 
 CACHE_LINE = 64
 HUGE_PAGE = 2 << 20
@@ -93,6 +97,7 @@ class DiskArrays:
     big: np.ndarray
     cell_head: np.ndarray
     images: Optional[np.ndarray] = None
+    spin: Optional[np.ndarray] = None
 
     def __post_init__(self):
         self.pack()
@@ -132,7 +137,8 @@ class DiskArrays:
 
         old = self.arrays()
         new = self._fresh_buffer()
-        for name in PER_DISK + (("images",) if self.images is not None else ()):
+        for name in PER_DISK + tuple(name for name in OPTIONAL_PER_DISK
+                                     if getattr(self, name) is not None):
             np.take(old[name], perm, axis=0, out=new[name])
         for name in ("heap", "list_head", "calendar", "block_rate", "big", "cell_head"):
             new[name][...] = old[name]

@@ -49,12 +49,22 @@ class DisksConfig:
     temperature: Optional[float] = None
     placement: str = "auto"
     zero_momentum: bool = False
+    inertia_factor: float = 0.5
+    rotational_temperature: float = 0.0
 
 
 @dataclass
 class RestitutionConfig:
     disk: float = 1.0
     wall: float = 1.0
+    tangential: float = -1.0
+    wall_tangential: float = -1.0
+
+
+@dataclass
+class FrictionConfig:
+    mu: Optional[float] = None
+    wall_mu: Optional[float] = None
 
 
 @dataclass
@@ -169,6 +179,7 @@ class SimConfig:
     disks: DisksConfig = field(default_factory=DisksConfig)
     restitution: RestitutionConfig = field(default_factory=RestitutionConfig)
     tc: TCConfig = field(default_factory=TCConfig)
+    friction: FrictionConfig = field(default_factory=FrictionConfig)
     gravity: list = field(default_factory=lambda: [0.0, 0.0])
     walls: WallsConfig = field(default_factory=WallsConfig)
     stop: StopConfig = field(default_factory=StopConfig)
@@ -199,7 +210,7 @@ def renamed_keys(cfg, warn=True):
             continue
         if warn:
             warnings.warn(f"{old}={value} is now called {new}={value} (the old name goes in "
-                          f"the next release)", FutureWarning)  # one location: said once
+                          f"the next release)", FutureWarning, stacklevel=1)  # said once
         OmegaConf.update(cfg, new, value)
         OmegaConf.update(cfg, old, None)
     return cfg

@@ -5,10 +5,13 @@ Layout written by :class:`RunWriter`:
   /particles/disks/box        dimension 2, boundary ["none"|"periodic"]×2, edges [Lx, Ly]
   /particles/disks/position   step int64[T], time float64[T], value float64[T, N, 2]
   /particles/disks/velocity   the same layout
+  /particles/disks/angular_velocity   when the disks turn (:mod:`sim.effects.rotation`):
+                              spins ω, value float64[T, N]
   /particles/disks/radius, mass, species   time-independent, [N]
   /observables/<name>         step, time, value — kinetic_energy, kinetic_energy_by_species
                               [T, S], collisions, wall_contacts, dissipated_energy,
-                              collision_virial; and one per observer the scene asks for
+                              collision_virial, rotational_energy (when the disks turn);
+                              and one per observer the scene asks for
                               (:mod:`sim.analysis.observers`): attribute ``dims``, coordinates
                               beside ``value``
   /events/contacts            when the scene logs events (``observe.event_log``): one row per
@@ -58,6 +61,15 @@ OBSERVABLES = {
     "potential_energy": ("energy", "Σ −m g·r (zero without gravity)"),
     "wall_work": ("energy", "cumulative work of moving and thermal walls on the disks"),
 }
+
+#: time series of /particles/disks (angular_velocity: when the disks turn)
+PARTICLE_SERIES = ("position", "velocity", "angular_velocity")
+
+#: observables that count (int64)
+COUNTS = ("collisions", "wall_contacts")
+
+#: observables of a run whose disks turn (:mod:`sim.effects.rotation`)
+SPIN_OBSERVABLES = {"rotational_energy": ("energy", "Σ I ω²/2 over all disks")}
 
 #: observables of run files written before a renaming: old name → name now
 RENAMED_OBSERVABLES = {"wall_collisions": "wall_contacts"}
@@ -142,7 +154,7 @@ class RunWriter:
         self.buffer_bytes = buffer_bytes
         self._last_checkpoint = -math.inf
         self._last_flush = -math.inf
-        self._frames = []  # buffered (step, time, position, velocity, observables)
+        self._frames = []  # buffered (step, time, {particle series: value}, observables)
         self._contacts = []  # buffered rows of the event log
         self._contact_bytes = 0
         self.file = h5py.File(path, mode)
@@ -181,14 +193,18 @@ class RunWriter:
                      "disk centres, wrapped into the box")
         _time_series(disks.create_group("velocity"), (n, 2), np.float64, "length/time",
                      "disk velocities")
+        if engine.spinning:
+            _time_series(disks.create_group("angular_velocity"), (n,), np.float64, "1/time",
+                         "spins ω about the z axis, counter-clockwise positive")
         for name, values, unit in (("radius", engine.radius, "length"),
                                    ("mass", engine.mass, "mass"),
                                    ("species", engine.species, "1")):
             disks.create_dataset(name, data=values, fletcher32=True).attrs["unit"] = unit
         observables = f.create_group("observables")
-        for name, (unit, description) in OBSERVABLES.items():
+        for name, (unit, description) in (OBSERVABLES | (SPIN_OBSERVABLES if engine.spinning
+                                                         else {})).items():
             shape = (engine.n_species,) if name.endswith("by_species") else ()
-            dtype = np.int64 if name.endswith("collisions") else np.float64
+            dtype = np.int64 if name in COUNTS else np.float64
             _time_series(observables.create_group(name), shape, dtype, unit, description)
         for observer in self.observers:
             group = observables.create_group(observer.name)
@@ -229,9 +245,13 @@ class RunWriter:
                        "potential_energy": engine.potential_energy(t),
                        "wall_work": engine.wall_work}
         position, velocity = engine.positions(t), engine.velocities(t)
+        particles = {"position": position, "velocity": velocity}
+        if engine.spinning:
+            particles["angular_velocity"] = engine.angular_velocities()
+            observables["rotational_energy"] = engine.rotational_energy()
         for observer in self.observers:
             observables[observer.name] = observer(engine, t, position, velocity)
-        self._frames.append((engine.contacts, t, position, velocity, observables))
+        self._frames.append((engine.contacts, t, particles, observables))
         if engine.event_log is not None:
             engine.drain_event_log()  # into _log_contacts
         now = wallclock.monotonic()
@@ -279,14 +299,15 @@ class RunWriter:
 
     def flush(self):
         """Write the buffered frames and flush the file."""
-        self._make_room(sum(p.nbytes + v.nbytes for _, _, p, v, _ in self._frames)
+        self._make_room(sum(value.nbytes for _, _, particles, _ in self._frames
+                            for value in particles.values())
                         + self._contact_bytes)
         if self._frames:
-            steps, times, positions, velocities, observables = zip(*self._frames, strict=True)
+            steps, times, particles, observables = zip(*self._frames, strict=True)
             disks = self.file["particles/disks"]
             first = self._flushed_frames
-            _write_frames(disks["position"], first, steps, times, positions)
-            _write_frames(disks["velocity"], first, steps, times, velocities)
+            for name in particles[0]:
+                _write_frames(disks[name], first, steps, times, [p[name] for p in particles])
             for name in observables[0]:
                 _write_frames(self.file["observables"][name], first, steps, times,
                               [o[name] for o in observables])
@@ -345,7 +366,8 @@ class RunWriter:
         logged contacts after the ``contacts``-th."""
         self.file["checkpoint"].attrs["latest"] = slot
         self._flush_file()
-        for group in [self.file["particles/disks/position"], self.file["particles/disks/velocity"],
+        disks = self.file["particles/disks"]
+        for group in [*(disks[name] for name in PARTICLE_SERIES if name in disks),
                       *self.file["observables"].values()]:
             for name in ("step", "time", "value"):
                 group[name].resize(snapshots, axis=0)

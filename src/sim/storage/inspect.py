@@ -243,7 +243,8 @@ def summary(path, verify=True):
                 return (read_intact(f[f"observables/{name}/value"])[0] if name in f["observables"]
                         else np.zeros_like(time))
 
-            energy, dissipated = observable("kinetic_energy"), observable("dissipated_energy")
+            energy = observable("kinetic_energy") + observable("rotational_energy")
+            dissipated = observable("dissipated_energy")
             potential, work = observable("potential_energy"), observable("wall_work")
             collisions = observable("collisions")
             species = read_intact(f["particles/disks/species"])[0]
@@ -269,7 +270,8 @@ def summary(path, verify=True):
             checksums = _checksums(f)
         except (*DAMAGE, yaml.YAMLError) as error:
             raise RunFileError(f"{path}: damaged or incomplete run file ({error})") from error
-    # energy balance: kinetic + potential + dissipated − work of the walls stays constant;
+    # energy balance: kinetic (translational and rotational) + potential + dissipated − work
+    # of the walls stays constant;
     # the drift is measured, over the intact snapshots, against the largest energy seen
     balance = energy + potential + dissipated - work
     intact = ~np.isnan(balance)
