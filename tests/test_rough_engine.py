@@ -1,0 +1,132 @@
+"""Rough disks in the engine (sim.effects.rotation): energy and momentum bookkeeping over many
+contacts, smooth disks unchanged, spins renumbered with the disks and restored from a
+checkpoint to the same bits, the run file's spins, and the config's one-line refusals."""
+
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import assert_no_overlap, gas
+from sim.analysis.datasets import open_run
+from sim.pipeline import runner
+from sim.pipeline.config import register
+from sim.pipeline.overrides import compose_overrides
+from sim.storage.inspect import summary
+
+register()
+
+
+def total_energy(engine):
+    return engine.kinetic_energy() + engine.rotational_energy()
+
+
+@pytest.mark.parametrize("beta, wall_beta", [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0)])
+def test_elastic_rough_contacts_keep_the_energy(beta, wall_beta):
+    engine = gas(300, 0.3, seed=1, tangential_restitution=beta,
+                 wall_tangential_restitution=wall_beta, rotational_temperature=0.5)
+    e0 = engine.initial_energy
+    assert e0 == pytest.approx(total_energy(engine), rel=1e-15)
+    engine.run(contacts=30_000)
+    assert engine.wall_contacts > 0 and engine.rotational_energy() > 0.0
+    assert total_energy(engine) == pytest.approx(e0, rel=1e-12)
+    assert abs(engine.dissipated_energy) < 1e-12 * e0  # (1 − β²) m_t g_t²/2 to round-off
+    assert_no_overlap(engine)
+
+
+def test_inelastic_rough_disks_book_every_loss():
+    """E_tr + E_rot + dissipated stays E₀ with normal, tangential and Coulomb losses, at
+    disks and walls, and the TC model."""
+    engine = gas(300, 0.3, periodic=(False, False), seed=2, restitution=0.9,
+                 wall_restitution=0.8, tc=1e-5, tangential_restitution=0.4,
+                 wall_tangential_restitution=0.2, friction=0.2, wall_friction=0.5)
+    assert engine.friction is not None
+    engine.run(contacts=30_000)
+    lost = engine.dissipated_energy
+    assert lost > 0.1 * engine.initial_energy
+    assert total_energy(engine) + lost == pytest.approx(engine.initial_energy, rel=1e-12)
+    assert_no_overlap(engine)
+
+
+def test_periodic_rough_gas_keeps_its_momentum():
+    engine = gas(300, 0.3, periodic=(True, True), seed=3, restitution=0.8,
+                 tangential_restitution=0.0, friction=0.1)
+    p0 = engine.momentum()
+    engine.run(contacts=20_000)
+    np.testing.assert_allclose(engine.momentum(), p0, atol=1e-12 * engine.n)
+
+
+def test_smooth_disks_are_the_smooth_engine_to_the_bit():
+    plain = gas(300, 0.3, seed=4, restitution=0.9)
+    smooth = gas(300, 0.3, seed=4, restitution=0.9, tangential_restitution=-1.0,
+                 wall_tangential_restitution=-1.0, friction=0.5)
+    assert (smooth.roughness, smooth.friction, smooth.spinning) == (None, None, False)
+    for engine in (plain, smooth):
+        engine.run(contacts=10_000)
+    np.testing.assert_array_equal(plain.positions(), smooth.positions())
+    np.testing.assert_array_equal(plain.velocities(), smooth.velocities())
+
+
+def test_spins_of_smooth_disks_stay_and_follow_the_renumbering():
+    """20 000 disks are renumbered by cell as they move; the spins go with them."""
+    n = 20_000
+    spin = np.linspace(-3.0, 3.0, n)
+    engine = gas(n, 0.3, periodic=(True, True), seed=5, spin=spin)
+    assert engine.spinning and engine.roughness is None
+    engine.run(events=3 * engine.reorder_every)
+    np.testing.assert_array_equal(engine.angular_velocities(), spin)
+
+
+def test_a_rough_run_restored_from_its_checkpoint_continues_to_the_same_bits():
+    def make():
+        return gas(300, 0.3, seed=6, restitution=0.9, tc=1e-5, tangential_restitution=0.5,
+                   friction=0.3, rotational_temperature=1.0)
+
+    straight = make()
+    straight.run(contacts=6_000)
+    half = make()
+    half.run(contacts=3_000)
+    restored = make()
+    restored.load_state_dict(half.state_dict())
+    restored.run(contacts=6_000)
+    np.testing.assert_array_equal(restored.angular_velocities(), straight.angular_velocities())
+    np.testing.assert_array_equal(restored.velocities(), straight.velocities())
+
+
+def test_the_run_file_holds_spins_and_their_energy(tmp_path):
+    cfg = compose_overrides(["disks.n=300", "restitution.disk=0.9",
+                             "restitution.tangential=0.5", "disks.rotational_temperature=1",
+                             "stop.collisions=3000", "output.progress=false"])
+    path = runner.run(cfg, tmp_path)
+    with h5py.File(path, "r") as f:
+        assert f["particles/disks/angular_velocity/value"].shape[1:] == (300,)
+    with open_run(path) as ds:
+        assert ds["angular_velocity"].dims == ("time", "disk")
+        assert float(ds["rotational_energy"][0]) > 0.0
+    info = summary(path)
+    assert info["energy_drift"] < 1e-12
+
+
+def test_a_smooth_run_file_has_no_spins(tmp_path):
+    cfg = compose_overrides(["disks.n=100", "stop.collisions=500", "output.progress=false"])
+    with h5py.File(runner.run(cfg, tmp_path), "r") as f:
+        assert "angular_velocity" not in f["particles/disks"]
+        assert "rotational_energy" not in f["observables"]
+
+
+@pytest.mark.parametrize("override, key", [
+    ("restitution.tangential=1.5", "restitution.tangential"),
+    ("friction.mu=0.3", "restitution.tangential"),
+    ("friction.mu=-1", "friction.mu"),
+    ("disks.inertia_factor=0", "disks.inertia_factor"),
+    ("disks.rotational_temperature=-1", "disks.rotational_temperature"),
+])
+def test_bad_rough_keys_get_one_line(override, key, tmp_path):
+    result = subprocess.run([sys.executable, "-m", "sim", override, "disks.n=50"], cwd=tmp_path,
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and key in lines[0], result.stderr
+    assert not any(tmp_path.iterdir())
