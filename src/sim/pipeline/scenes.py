@@ -415,6 +415,7 @@ SCENES = {spec.name: spec for spec in (
               sections=("projectile", "bed"), check=_check_crater, packing_fraction=_bed_packing),
     SceneSpec("cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("driven", gas, given_count, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("rough_cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("vibrated_bed", vibrated_bed, _bed_count, preparation=_bed_preparation,
               sections=("bed",), check=_check_vibrated_bed, packing_fraction=_bed_packing),
 )}

@@ -1,0 +1,106 @@
+"""Figure 12: cooling rough disks (ξ = 0.9, q = 1/2, the ``rough_cooling`` scene). From spins
+at rest, T_rot/T_tr climbs within a few collisions per disk to the ratio of the homogeneous
+cooling state, which the two-temperature Maxwellian theory predicts
+(:func:`sim.analysis.theory.rough_disk_temperature_ratio`); from there on T_tr follows Haff's
+law with the rate of rough disks (:func:`sim.analysis.theory.rough_disk_haff_temperature`,
+drawn from the first snapshot of ``WINDOW``, with Enskog's collision frequency there).
+
+T_tr is taken in the frame of the local flow on 4 × 4 cells
+(:func:`sim.analysis.datasets.granular_temperatures`), T_rot = ⟨I ω²⟩, both averaged over the
+runs (seeds) at each snapshot; the ratio's error is the standard error over the runs of each
+run's mean over ``WINDOW``. The more nearly smooth the disks (β → −1), the weaker the coupling
+of spin and translation and the slower the climb (β = −0.5 has not settled after 24 collisions
+per disk, so it is not drawn). The gas is dilute and its box small against the length at which
+a cooling gas grows shear and clusters, L_c = 2√π/(n σ √(1 − ξ²)) = 2.3 box sides for
+ξ = 0.9 at N = 500, φ = 0.02 (roughness dissipates more per collision and shortens it
+somewhat), so that it stays homogeneous over the window.
+"""
+
+import numpy as np
+
+from sim.analysis.datasets import granular_temperatures, open_sweep
+from sim.analysis.theory import (
+    enskog_collision_frequency,
+    kolafa_rottner_z,
+    rough_disk_haff_temperature,
+    rough_disk_temperature_ratio,
+)
+from sim.checks.rows import block_means
+from sim.effects.rotation import moment_of_inertia
+from sim.figures.style import figure, save
+
+NAME = "fig12_rough_cooling"
+RESTITUTION = 0.9
+ROUGHNESS = (0.0, 0.5, 1.0)
+#: collisions per disk over which a run's ratio is averaged: the homogeneous cooling state
+WINDOW = (14.0, 24.0)
+#: disks and packing fraction: the box is 2.3 clustering lengths of ξ = 0.9 (module docstring)
+DISKS, PACKING = 500, 0.02
+
+
+def sweeps(quick):
+    seeds = 4 if quick else 16
+    return {"rough": ["scenario=rough_cooling", f"disks.n={DISKS}",
+                      f"disks.packing_fraction={PACKING}",
+                      f"restitution.disk={RESTITUTION}",
+                      "restitution.tangential=" + ",".join(map(str, ROUGHNESS)),
+                      f"stop.collisions={int(WINDOW[1] * DISKS / 2)}",
+                      f"output.every_collisions={DISKS // 4}", f"seed=range(0,{seeds})"]}
+
+
+def temperatures(run, q):
+    """(T_tr [snapshots], T_rot [snapshots]) of one run of the sweep (a Dataset without the
+    swept dimensions)."""
+    mass, radius = run["mass"].values, run["radius"].values
+    translational = granular_temperatures(run["position"].values, run["velocity"].values, mass,
+                                          np.zeros(mass.size, int), run.attrs["box"], 4)[:, 0]
+    inertia = moment_of_inertia(q, mass, radius)
+    rotational = np.mean(inertia * run["angular_velocity"].values ** 2, axis=1)
+    return translational, rotational
+
+
+def draw(runs, sweeps, out_dir):
+    ds = open_sweep(sweeps["rough"])
+    q = 0.5
+    n = ds.sizes["disk"]
+    phi = float(np.sum(np.pi * ds["radius"] ** 2) / np.prod(ds.attrs["box"]))
+    chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
+    sigma = 2.0 * float(ds["radius"].max())
+    fig, (left, right) = figure(width=10)
+    rows = []
+    for k, beta in enumerate(ds["restitution_tangential"].values):
+        curves, ratios = [], []
+        for seed in ds["seed"].values:
+            run = ds.sel(restitution_tangential=beta, seed=seed)
+            translational, rotational = temperatures(run, q)
+            per_disk = 2.0 * run["collisions"].values / n
+            window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
+            curves.append((translational, rotational))
+            ratios.append(np.mean(rotational[window] / translational[window]))
+        translational, rotational = np.mean(curves, axis=0)
+        ratio, error = block_means(ratios)
+        theory = rough_disk_temperature_ratio(RESTITUTION, beta, q)
+        rows.append((beta, theory, ratio, error, len(ratios)))
+        left.plot(per_disk, rotational / translational, color=f"C{k}",
+                  label=f"β = {beta:g}: {ratio:.3f} ± {error:.3f}")
+        left.axhline(theory, color=f"C{k}", ls=":", lw=1.2)
+        time = run["time"].values
+        right.semilogy(time, translational / translational[0], color=f"C{k}",
+                       label=f"β = {beta:g}")
+        start = np.argmax(window)  # Haff's law from the first snapshot of the cooling state
+        frequency = enskog_collision_frequency(n, sigma, chi, translational[start])
+        right.semilogy(time[start:], rough_disk_haff_temperature(
+            time[start:] - time[start], translational[start] / translational[0], frequency,
+            RESTITUTION, beta, q), color=f"C{k}", ls=":", lw=1.5)
+    left.axvspan(*WINDOW, color="0.9", zorder=0, label="averaged (cooling state)")
+    left.set(xlabel="collisions per disk", ylabel="T_rot / T_tr",
+             title=f"ξ = {RESTITUTION}, q = {q}, N = {n}, φ = {phi:.3g}, {ds.sizes['seed']} "
+                   f"runs; dotted: theory")
+    left.legend(fontsize=7)
+    right.set(xlabel="time", ylabel="T_tr / T_tr(0)",
+              title="T_tr; dotted: Haff's law of rough disks")
+    right.legend(fontsize=7)
+    np.savetxt(out_dir / f"{NAME}.csv", np.array(rows), delimiter=",", fmt="%.6g",
+               header="tangential_restitution,theory_ratio,measured_ratio,standard_error,runs",
+               comments="")
+    return save(fig, out_dir, NAME)
