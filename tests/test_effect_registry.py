@@ -26,11 +26,12 @@ EFFECT_MODULES = sorted(p.stem for p in Path(sim.effects.__file__).parent.glob("
 TESTS = Path(__file__).parent
 PROTOCOL = ("check_config", "engine_arguments", "loop_values")
 
-#: every effect on, so that each reads all of its keys
+#: every effect on, so that each reads all of its keys (the pressure tensor aside: it is
+#: refused with rough disks, and its switch is read either way)
 EVERY_EFFECT_ON = ("restitution.disk=0.9", "restitution.wall=0.9", "tc.time=1e-6",
                    "gravity=[0,-1]", "walls.bottom.amplitude=0.01", "walls.bottom.frequency=10",
                    "walls.left.temperature=1", "observe.mean_squared_displacement=true",
-                   "observe.pressure_tensor=true", "observe.event_log=true",
+                   "observe.event_log=true",
                    "restitution.tangential=0.5", "restitution.wall_tangential=0.5",
                    "friction.mu=0.3", "friction.wall_mu=0.3", "disks.inertia_factor=0.4",
                    "disks.rotational_temperature=1")

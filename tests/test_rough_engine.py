@@ -50,6 +50,46 @@ def test_inelastic_rough_disks_book_every_loss():
     assert_no_overlap(engine)
 
 
+def test_rough_disks_under_gravity_on_a_vibrating_floor_book_every_energy():
+    """Two species with their own β and μ, rough walls, gravity, the TC model and a
+    vibrating floor: E_tr + E_rot + U + dissipated − work of the floor stays E₀ + U₀."""
+    from sim.engine import Engine
+
+    placed = gas(300, 0.3, seed=7)
+    species = np.arange(300) % 2
+    engine = Engine(placed.positions(), placed.velocities(), placed.radius, species=species,
+                    restitution=[[0.9, 0.8], [0.8, 0.7]], wall_restitution=0.9, tc=1e-4,
+                    gravity=[0.0, -1.0], walls={"bottom": {"amplitude": 0.005,
+                                                           "frequency": 40.0}},
+                    tangential_restitution=[[0.5, 0.0], [0.0, -0.5]], friction=[[0.2, 0.4],
+                                                                                [0.4, 0.6]],
+                    wall_tangential_restitution=[0.3, 0.3, 0.6, -1.0], wall_friction=0.5)
+    u0 = engine.potential_energy()
+    engine.run(contacts=30_000)
+    assert engine.wall_work != 0.0 and engine.rotational_energy() > 0.0
+    balance = (total_energy(engine) + engine.potential_energy() + engine.dissipated_energy
+               - engine.wall_work)
+    assert balance == pytest.approx(engine.initial_energy + u0, rel=1e-11)
+    assert_no_overlap(engine)
+
+
+def test_the_tc_model_holds_when_only_rough_contacts_dissipate():
+    engine = gas(100, 0.3, seed=8, tangential_restitution=0.0, tc=1e-4)
+    assert engine.tc == 1e-4 and engine.collapse is not None
+
+
+@pytest.mark.parametrize("options, match", [
+    ({"friction": 0.3}, "sticking"),
+    ({"tangential_restitution": 0.5, "wall_friction": 0.3, "periodic": (True, True)},
+     "periodic box has no walls"),
+    ({"tangential_restitution": 0.5, "pressure_tensor": True}, "pressure tensor"),
+    ({"spin": [1.0, 2.0]}, "spin must be"),
+])
+def test_the_engine_refuses_what_it_would_ignore(options, match):
+    with pytest.raises(ValueError, match=match):
+        gas(50, 0.2, seed=9, **options)
+
+
 def test_periodic_rough_gas_keeps_its_momentum():
     engine = gas(300, 0.3, periodic=(True, True), seed=3, restitution=0.8,
                  tangential_restitution=0.0, friction=0.1)
@@ -61,7 +101,7 @@ def test_periodic_rough_gas_keeps_its_momentum():
 def test_smooth_disks_are_the_smooth_engine_to_the_bit():
     plain = gas(300, 0.3, seed=4, restitution=0.9)
     smooth = gas(300, 0.3, seed=4, restitution=0.9, tangential_restitution=-1.0,
-                 wall_tangential_restitution=-1.0, friction=0.5)
+                 wall_tangential_restitution=-1.0, inertia_factor=0.4)
     assert (smooth.roughness, smooth.friction, smooth.spinning) == (None, None, False)
     for engine in (plain, smooth):
         engine.run(contacts=10_000)
@@ -122,10 +162,13 @@ def test_a_smooth_run_file_has_no_spins(tmp_path):
     ("friction.mu=-1", "friction.mu"),
     ("disks.inertia_factor=0", "disks.inertia_factor"),
     ("disks.rotational_temperature=-1", "disks.rotational_temperature"),
+    ("disks.rotational_temperature=inf", "disks.rotational_temperature"),
+    ("box.boundary=periodic restitution.wall_tangential=0.5", "restitution.wall_tangential"),
+    ("restitution.tangential=0.5 observe.pressure_tensor=true", "observe.pressure_tensor"),
 ])
 def test_bad_rough_keys_get_one_line(override, key, tmp_path):
-    result = subprocess.run([sys.executable, "-m", "sim", override, "disks.n=50"], cwd=tmp_path,
-                            capture_output=True, text=True, timeout=600)
+    result = subprocess.run([sys.executable, "-m", "sim", *override.split(), "disks.n=50"],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and key in lines[0], result.stderr

@@ -49,6 +49,13 @@ class Effect:
 WALL_SECTIONS = tuple(f"walls.{wall}" for wall in ("left", "right", "bottom", "top"))
 
 EFFECTS = (
+    Effect("rotation", ("roughness", "friction", "spin"),
+           ("restitution.tangential", "restitution.wall_tangential", "friction.mu",
+            "friction.wall_mu", "disks.inertia_factor", "disks.rotational_temperature",
+            "box.boundary", "observe.pressure_tensor"),
+           ("rough_equipartition", "rough_cooling_0.9_0.5", "rough_cooling_0.9_0.0",
+            "rough_cooling_0.8_-0.5", "rough_cooling_0.7_0.5"),
+           ("rotation", "friction")),
     Effect("restitution", ("restitution", "wall_restitution", "collapse"),
            ("restitution.disk", "restitution.wall"),
            ("haff_0.9", "haff_0.8", "mixture_0.8", "bouncing_ball"),
@@ -72,12 +79,6 @@ EFFECTS = (
            ("pressure_tensor",)),
     Effect("event_log", ("event_log",), ("observe.event_log",),
            ("test_observers.py::test_event_log_holds_every_contact",), ("event_log",)),
-    Effect("rotation", ("roughness", "friction", "spin"),
-           ("restitution.tangential", "restitution.wall_tangential", "friction.mu",
-            "friction.wall_mu", "disks.inertia_factor", "disks.rotational_temperature"),
-           ("rough_equipartition", "rough_cooling_0.9_0.5", "rough_cooling_0.9_0.0",
-            "rough_cooling_0.8_-0.5", "rough_cooling_0.7_0.5"),
-           ("rotation", "friction")),
 )
 
 #: The effects of a scene as the compiled loop takes them, one field per entry of the

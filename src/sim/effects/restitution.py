@@ -20,6 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from sim.effects.rotation import dissipates
 from sim.effects.rules import effect_rule
 from sim.engine.parameters import per_disk
 from sim.pipeline.input_checks import within
@@ -51,12 +52,14 @@ def engine_arguments(cfg):
 
 
 def loop_values(keywords, context):
-    """ξ per species pair, ξ_w, and the collapse watch when either dissipates; its default
-    interval from the scene's initial rms speed and median radius."""
+    """ξ per species pair, ξ_w, and the collapse watch when a contact dissipates (normal
+    restitution, or rough contacts: :func:`sim.effects.rotation.dissipates`, of the effect
+    before it); its default interval from the scene's initial rms speed and median radius."""
     restitution = restitution_matrix(keywords["restitution"], context["n_species"])
     wall_restitution = wall_restitution_value(keywords["wall_restitution"])
     collapse = None
-    if restitution is not None or wall_restitution is not None:
+    if (restitution is not None or wall_restitution is not None
+            or dissipates(context["roughness"], context["friction"])):
         energy, mass = context["initial_energy"], context["mass"]
         v_rms = math.sqrt(2.0 * energy / mass.sum()) if energy else 1.0
         crossing_time = 2.0 * float(np.median(context["radius"])) / v_rms

@@ -47,10 +47,12 @@ theory of cooling rough disks (:mod:`sim.analysis.theory`) are in docs/rough-dis
 """
 
 import math
+import sys
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from omegaconf import OmegaConf
 
 from sim.effects.rules import effect_rule
 from sim.effects.thermal_walls import is_thermal
@@ -107,11 +109,23 @@ def check_config(cfg):
         if mu is not None and beta == SMOOTH:
             raise ConfigError(key, beta, "β₀ > −1 with friction (β₀ = −1 never sticks: "
                                          "the contact stays smooth whatever μ_f)")
+    rough = r.tangential > SMOOTH or r.wall_tangential > SMOOTH
+    if cfg.box.boundary == "periodic":
+        for key in ("restitution.wall_tangential", "friction.wall_mu"):
+            default = SMOOTH if key.startswith("restitution") else None
+            if OmegaConf.select(cfg, key) != default:
+                raise ConfigError(key, OmegaConf.select(cfg, key),
+                                  f"{default} in a periodic box, which has no walls")
+    if rough and cfg.observe.pressure_tensor:
+        raise ConfigError("observe.pressure_tensor", True, "false with rough disks (the "
+                          "tangential impulses make the collision stress asymmetric; it is "
+                          "not computed)")
     q = cfg.disks.inertia_factor
     if not 0.0 < q <= 1.0:
         raise ConfigError("disks.inertia_factor", q, "q = I/(m a²) in (0, 1] (1/2 uniform "
                                                      "disk, 1 ring)")
-    positive("disks.rotational_temperature", cfg.disks.rotational_temperature, zero=True)
+    within("disks.rotational_temperature", cfg.disks.rotational_temperature, 0.0,
+           sys.float_info.max, "a finite temperature ≥ 0 (0: spins at rest)")
 
 
 def engine_arguments(cfg):
@@ -139,27 +153,44 @@ def _walls(value, default):
 
 def loop_values(keywords, context):
     """Roughness, friction and the spins (None when every contact is smooth and no disk
-    turns); the initial spins from ``spin`` or drawn at ``rotational_temperature``."""
+    turns); the initial spins from ``spin`` or drawn at ``rotational_temperature``. Friction
+    on smooth contacts (β₀ = −1 never sticks), wall values in a box without walls and the
+    pressure tensor of rough contacts (their impulses make it asymmetric) are refused."""
     s = context["n_species"]
     beta = _pairs(keywords["tangential_restitution"], s, SMOOTH, "tangential_restitution")
     beta_wall = _walls(keywords["wall_tangential_restitution"], SMOOTH)
     mu = _pairs(keywords["friction"], s, math.inf, "friction")
     mu_wall = _walls(keywords["wall_friction"], math.inf)
     q = float(keywords["inertia_factor"])
-    for value in (*beta.ravel(), *beta_wall):
-        rough_parameters(value, None, q)
-    for value in (*mu.ravel(), *mu_wall):
-        if not value >= 0.0:
-            raise ValueError(f"friction coefficient must be ≥ 0, got {value}")
+    if np.all(context["periodic"]) and (np.any(beta_wall > SMOOTH)
+                                        or keywords["wall_friction"] is not None):
+        raise ValueError("a periodic box has no walls for wall_tangential_restitution or "
+                         "wall_friction")
+    for b, m in zip((*beta.ravel(), *beta_wall), (*mu.ravel(), *mu_wall), strict=True):
+        rough_parameters(b, None if m == math.inf else m, q)
+    for given, sticking, name in ((keywords["friction"], beta, "friction"),
+                                  (keywords["wall_friction"], beta_wall, "wall_friction")):
+        if given is not None and np.all(sticking == SMOOTH):
+            raise ValueError(f"{name} needs a sticking tangential restitution β₀ > −1 (β₀ = "
+                             f"−1 never sticks: the contact stays smooth whatever μ_f)")
     rough = bool(np.any(beta > SMOOTH) or np.any(beta_wall > SMOOTH))
+    if rough and keywords["pressure_tensor"]:
+        raise ValueError("the pressure tensor of rough disks is not computed (the tangential "
+                         "impulses make the collision stress asymmetric)")
     spin = initial_spins(keywords, context, q)
     if not rough and not np.any(spin):
         return {"roughness": None, "friction": None, "spin": None}
+    limited = np.isfinite([*mu.ravel(), *mu_wall]).any()
     return {"roughness": Roughness(q, beta, beta_wall) if rough else None,
-            "friction": (Friction(mu, mu_wall) if rough and np.isfinite([*mu.ravel(),
-                                                                          *mu_wall]).any()
-                         else None),
+            "friction": Friction(mu, mu_wall) if limited else None,
             "spin": spin}
+
+
+def dissipates(roughness, friction):
+    """Whether rough contacts lose energy (|β| < 1 somewhere, or friction)."""
+    return roughness is not None and (
+        friction is not None or bool(np.any(np.abs(roughness.beta) < 1.0))
+        or bool(np.any(np.abs(roughness.beta_wall) < 1.0)))
 
 
 def initial_spins(keywords, context, q):
@@ -169,10 +200,11 @@ def initial_spins(keywords, context, q):
     if keywords["spin"] is not None:
         if temperature:
             raise ValueError("give the initial spins or a rotational temperature, not both")
-        spin = np.array(np.broadcast_to(np.asarray(keywords["spin"], dtype=np.float64), (n,)))
-        if not np.all(np.isfinite(spin)):
-            raise ValueError("initial spins must be finite")
-        return spin
+        spin = np.asarray(keywords["spin"], dtype=np.float64)
+        if spin.shape not in ((), (n,)) or not np.all(np.isfinite(spin)):
+            raise ValueError(f"spin must be one finite number or n = {n} of them, got shape "
+                             f"{spin.shape}")
+        return np.array(np.broadcast_to(spin, (n,)))
     if not 0.0 <= temperature < math.inf:
         raise ValueError(f"rotational_temperature must be finite and ≥ 0, got {temperature}")
     if not temperature:
@@ -335,23 +367,24 @@ def maxwellian_spins(rng, temperature, inertia):
     return rng.normal(0.0, 1.0, inertia.shape) * np.sqrt(temperature / inertia)
 
 
-def _smooth_disks(roughness, friction, spin, tc, i, j, rx, ry, normal_impulse, t, t_last,
-                  s_i, s_j, disks, m_i, m_j):
+def _smooth_disks(roughness, friction, spin, tc, i, j, rx, ry, virial, t, t_last, s_i, s_j,
+                  disks, m_i, m_j):
     return 0.0
 
 
 @effect_rule(_smooth_disks)
-def rough_collision(roughness, friction, spin, tc, i, j, rx, ry, normal_impulse, t, t_last,
-                    s_i, s_j, disks, m_i, m_j):
+def rough_collision(roughness, friction, spin, tc, i, j, rx, ry, virial, t, t_last, s_i, s_j,
+                    disks, m_i, m_j):
     """The tangential part of the collision of disks i and j (species s_i, s_j) at time t,
-    at separation r = r_i − r_j, after a normal impulse P_n (zero: no contact, nothing to
-    do), with the TC model's choice (:func:`tc_roughness`). Returns the energy lost."""
-    if normal_impulse <= 0.0:
+    at separation r = r_i − r_j, after the normal impulse whose virial r·Δp_i = P_n |r| the
+    smooth rule returned (zero: no contact, nothing to do), with the TC model's choice
+    (:func:`tc_roughness`). Returns the energy lost."""
+    if virial <= 0.0:
         return 0.0
     beta = tc_roughness(tc, roughness.beta[s_i, s_j], t, t_last[i], t_last[j])
     inverse_r = 1.0 / math.sqrt(rx * rx + ry * ry)
-    return rough_contact(i, j, rx * inverse_r, ry * inverse_r, normal_impulse, disks, spin,
-                         m_i, m_j, roughness.q, beta, friction_of(friction, s_i, s_j))
+    return rough_contact(i, j, rx * inverse_r, ry * inverse_r, virial * inverse_r, disks,
+                         spin, m_i, m_j, roughness.q, beta, friction_of(friction, s_i, s_j))
 
 
 def _smooth_wall(roughness, friction, spin, tc, temperature, i, wall, impulse, t, t_last,

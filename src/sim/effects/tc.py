@@ -32,10 +32,9 @@ def engine_arguments(cfg):
 
 
 def loop_values(keywords, context):
-    """t_c, None unless a contact dissipates (ξ or ξ_w in ``context``)."""
-    dissipative = (context["restitution"] is not None
-                   or context["wall_restitution"] is not None)
-    return {"tc": tc_time(keywords["tc"], dissipative)}
+    """t_c, None unless a contact dissipates: then the collapse watch, which keeps the
+    contact times the model reads, is on (:mod:`sim.effects.restitution`)."""
+    return {"tc": tc_time(keywords["tc"], context["collapse"] is not None)}
 
 
 def tc_time(tc, dissipative):

@@ -29,8 +29,9 @@ _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX_2 = np.uint64(0x94D049BB133111EB)
 
 
-KEYWORDS = {"seed": (0, "keys the random draws of thermal walls (same seed, same bits); "
-                        "their temperatures are given with ``walls``")}
+KEYWORDS = {"seed": (0, "keys the random draws of thermal walls and of the initial spins "
+                        "(same seed, same bits); the walls' temperatures are given with "
+                        "``walls``")}
 
 
 def check_config(cfg):

@@ -190,8 +190,7 @@ def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
     s_i = per_disk(disks.species, i)
     s_j = per_disk(disks.species, j)
     lost += rough_collision(effects.roughness, effects.friction, effects.spin, effects.tc, i, j,
-                            rx, ry, virial / (table[i, RADIUS] + table[j, RADIUS]), t, t_last,
-                            s_i, s_j, table, m_i, m_j)
+                            rx, ry, virial, t, t_last, s_i, s_j, table, m_i, m_j)
     tallies.pair_collisions[min(s_i, s_j), max(s_i, s_j)] += 1
     disks.coll_count[i] += 1
     disks.coll_count[j] += 1

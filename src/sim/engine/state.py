@@ -37,8 +37,6 @@ from sim.engine.queue import NEXT, PREV
 PER_DISK = ("table", "delta", "mass", "species", "is_big", "coll_count", "contacts", "t_last",
             "streak", "event_time", "event_partner", "event_count", "links", "nb_start", "nb_cap",
             "nb_count", "cell_next", "cell_prev", "cell_of", "order")
-#: per-disk arrays of effects, None when the effect is off
-OPTIONAL_PER_DISK = ("images", "spin")
 
 CACHE_LINE = 64
 HUGE_PAGE = 2 << 20
@@ -154,3 +152,7 @@ class DiskArrays:
                    new["nb"])
         for name, array in new.items():
             setattr(self, name, array)
+
+
+#: per-disk arrays of effects (the fields that default to None): None when the effect is off
+OPTIONAL_PER_DISK = tuple(f.name for f in fields(DiskArrays) if f.default is None)

@@ -17,6 +17,7 @@ somewhat), so that it stays homogeneous over the window.
 """
 
 import numpy as np
+import yaml
 
 from sim.analysis.datasets import granular_temperatures, open_sweep
 from sim.analysis.theory import (
@@ -61,7 +62,10 @@ def temperatures(run, q):
 
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["rough"])
-    q = 0.5
+    q = float(yaml.safe_load(ds["config"].values.flat[0])["disks"]["inertia_factor"])
+    per_disk = 2.0 * ds["collisions"].isel(restitution_tangential=0, seed=0).values / ds.sizes[
+        "disk"]
+    window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     n = ds.sizes["disk"]
     phi = float(np.sum(np.pi * ds["radius"] ** 2) / np.prod(ds.attrs["box"]))
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
@@ -73,8 +77,6 @@ def draw(runs, sweeps, out_dir):
         for seed in ds["seed"].values:
             run = ds.sel(restitution_tangential=beta, seed=seed)
             translational, rotational = temperatures(run, q)
-            per_disk = 2.0 * run["collisions"].values / n
-            window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
             curves.append((translational, rotational))
             ratios.append(np.mean(rotational[window] / translational[window]))
         translational, rotational = np.mean(curves, axis=0)
