@@ -58,8 +58,11 @@ def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
         assert "scene: " + cfg.scene in f["parameters"].attrs["config"]
         observables = {name_: f[f"observables/{name_}/value"][()] for name_ in
                        ("kinetic_energy", "potential_energy", "dissipated_energy", "wall_work")}
-    # kinetic + potential + dissipated − work of the walls stays what it was
-    balance = (observables["kinetic_energy"] + observables["potential_energy"]
+        rotational = (f["observables/rotational_energy/value"][()]
+                      if "rotational_energy" in f["observables"] else 0.0)
+    # kinetic (translational and rotational) + potential + dissipated − work of the walls
+    # stays what it was
+    balance = (observables["kinetic_energy"] + rotational + observables["potential_energy"]
                + observables["dissipated_energy"] - observables["wall_work"])
     scale = max(observables["kinetic_energy"].max(), abs(observables["wall_work"]).max())
     np.testing.assert_allclose(balance, balance[0], rtol=0, atol=1e-10 * scale)
