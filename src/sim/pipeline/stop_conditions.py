@@ -20,8 +20,10 @@ PAIRWISE_LIMIT = 2000
 
 
 def at_rest(fraction):
-    """Stop predicate of ``stop.at_rest``: the kinetic energy of every species has fallen below
-    ``fraction`` of the initial total. Hard-disk dynamics has no energy scale (a run at
+    """Stop predicate of ``stop.at_rest``: the translational kinetic energy of every species
+    has fallen below ``fraction`` of the initial total (which counts the spins of rough
+    disks: a bed whose disks still turn in place is at rest). Hard-disk dynamics has no
+    energy scale (a run at
     speeds ×λ is the same run in time /λ, unless the TC model's fixed t_c intervenes), so it
     ends runs that differ only in their speeds at the same stage."""
     def predicate(engine):
