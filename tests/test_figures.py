@@ -13,7 +13,7 @@ def test_quick_figures(tmp_path):
     for name in ("fig01_single_disk", "fig02_two_disks", "fig03_scattering", "fig04_gas_snapshot",
                  "fig05_maxwell_boltzmann", "fig06_mixture", "fig07_mixture_cooling",
                  "fig08_crater_grid", "fig09_crater_radius", "fig10_crater_speed",
-                 "fig11_crater_gravity"):
+                 "fig11_crater_gravity", "fig12_rough_cooling", "fig13_crater_rough"):
         assert (out / f"{name}.png").stat().st_size > 10_000
     path = np.loadtxt(out / "fig01_single_disk.csv", delimiter=",", skiprows=1)
     x, y, distance, energy = path[:, 2], path[:, 3], path[:, 4], path[:, 5]
@@ -67,6 +67,18 @@ def test_quick_figures(tmp_path):
     opened = gravity[:, 2] > np.pi * 0.05**2
     assert opened.sum() >= 2
     assert np.all(gravity[opened, 3] < 0.5 * gravity[opened, 2])
+    # β, theory's T_rot/T_tr, measured, its standard error, runs: the ratio rises with β, and
+    # lies within 6 % of the two-temperature theory (its Maxwellian closure; 1–3 % below it
+    # with 16 runs) and four standard errors
+    rough = np.loadtxt(out / "fig12_rough_cooling.csv", delimiter=",", skiprows=1)
+    assert np.all(np.diff(rough[:, 0]) > 0) and np.all(np.diff(rough[:, 2]) > 0)
+    assert np.all(np.abs(rough[:, 2] - rough[:, 1]) < 0.06 * rough[:, 1] + 4 * rough[:, 3])
+    # radius, rough (0/1), mean area, its error, floor-limited beds: at the same stop (10 %
+    # of the energy left) a rough bed's crater is the smaller one at every radius
+    crater = np.loadtxt(out / "fig13_crater_rough.csv", delimiter=",", skiprows=1)
+    smooth, rough_bed = crater[crater[:, 1] == 0], crater[crater[:, 1] == 1]
+    np.testing.assert_array_equal(smooth[:, 0], rough_bed[:, 0])
+    assert np.all(rough_bed[:, 2] < smooth[:, 2])
     for movie in ("two_disks", "crater", "cooling"):
         assert (out / f"movie_{movie}.mp4").stat().st_size > 10_000
     # a second call finds its runs and makes none again
