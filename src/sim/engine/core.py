@@ -12,7 +12,6 @@ in the original order.
 """
 
 import math
-from dataclasses import fields
 
 import numpy as np
 
@@ -50,11 +49,7 @@ from sim.engine.sizing import (
     shell_ratio,
     stall_interval,
 )
-from sim.engine.state import DiskArrays
-
-#: fields of :class:`Effects` that are per-disk state: kept in :class:`DiskArrays` (renumbered
-#: and checkpointed with the disks), the others as attributes of :class:`Engine`
-DISK_EFFECTS = tuple(f.name for f in fields(DiskArrays) if f.name in Effects._fields)
+from sim.engine.state import OPTIONAL_PER_DISK, DiskArrays
 
 
 class Engine(Running, Observables, Checkpoints):
@@ -108,7 +103,7 @@ class Engine(Running, Observables, Checkpoints):
         values, self.effect_keywords = loop_values(effects, {
             "n": n, "n_species": self.n_species, "box": box, "periodic": periodic,
             "radius": radius, "mass": mass, "initial_energy": self.initial_energy})
-        disk_effects = {field: values.pop(field) for field in DISK_EFFECTS}
+        disk_effects = {field: values.pop(field) for field in OPTIONAL_PER_DISK}
         for field, value in values.items():
             setattr(self, field, value)
         # the far edge of the disks, whose ulps bound those of their coordinates (a disk
@@ -149,7 +144,7 @@ class Engine(Running, Observables, Checkpoints):
     def _build(self, position, velocity, shell, lead, list_capacity, disk_effects,
                first_event):
         """Size shells and cells, allocate the state, link neighbours, schedule events;
-        ``disk_effects``: the fields of :data:`DISK_EFFECTS`, ``first_event``:
+        ``disk_effects``: the fields of :data:`OPTIONAL_PER_DISK`, ``first_event``:
         :func:`first_event_time`."""
         n, radius, box = self.n, self.radius, self.box
         median = float(np.median(radius))
@@ -267,8 +262,8 @@ class Engine(Running, Observables, Checkpoints):
 
     def _effects(self):
         """The scene's effects as the compiled loop takes them (:class:`sim.effects.Effects`):
-        the fields of :data:`DISK_EFFECTS` from the disk state, the others from the engine."""
-        return Effects(**{field: getattr(self.disks if field in DISK_EFFECTS else self, field)
+        the fields of :data:`OPTIONAL_PER_DISK` from the disk state, the others from the engine."""
+        return Effects(**{field: getattr(self.disks if field in OPTIONAL_PER_DISK else self, field)
                           for field in Effects._fields})
 
     def _per_disk_parameters(self):

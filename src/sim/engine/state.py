@@ -154,5 +154,7 @@ class DiskArrays:
             setattr(self, name, array)
 
 
-#: per-disk arrays of effects (the fields that default to None): None when the effect is off
+#: per-disk arrays of effects (the fields that default to None, each a field of
+#: :class:`sim.effects.Effects` too): None when the effect is off; the engine keeps its other
+#: effect fields as attributes
 OPTIONAL_PER_DISK = tuple(f.name for f in fields(DiskArrays) if f.default is None)
