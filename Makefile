@@ -3,8 +3,10 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+# the results the docs and the README include; only the targets below write them
+RESULTS := docs/results
 
-.PHONY: help venv run test validate bench figures accuracy lint clean
+.PHONY: help venv run test validate bench speed figures accuracy readme docs lint clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -12,7 +14,7 @@ help:  ## list the targets
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet -e '.[test,docs]'
 	touch $(STAMP)
 
 venv: $(STAMP)  ## make the virtual environment and install sim into it
@@ -23,17 +25,30 @@ run: $(STAMP)  ## run the default scene
 test: $(STAMP)  ## quick tests (long physics runs are marked slow), one worker per core
 	$(PY) -m pytest -q -n logical
 
-validate: $(STAMP)  ## every test, slow physics runs included; writes outputs/validation/table.md
+validate: $(STAMP)  ## every test, slow physics runs included; the table into outputs/validation/ and docs/results/
 	$(PY) -m pytest -q -m ""
+	cp outputs/validation/table.md $(RESULTS)/validation.md
 
-figures: $(STAMP)  ## every figure into outputs/figures/ (QUICK=1: small versions)
+figures: $(STAMP)  ## every figure into outputs/figures/, the README's picture into docs/results/ (QUICK=1: small versions only)
 	$(PY) -m sim.figures $(if $(QUICK),--quick)
+	$(if $(QUICK),,cp outputs/figures/fig08_crater_grid.png $(RESULTS)/crater.png)
 
-accuracy: $(STAMP)  ## accuracy against wall time for every knob into outputs/accuracy_cost/ (QUICK=1: fewer settings)
+accuracy: $(STAMP)  ## accuracy against wall time for every knob into outputs/accuracy_cost/ and docs/results/ (QUICK=1: fewer settings, not copied)
 	$(PY) experiments/accuracy_cost/study.py $(if $(QUICK),--quick)
+	$(if $(QUICK),,cp outputs/accuracy_cost/summary.md $(RESULTS)/accuracy.md)
 
 bench: $(STAMP)  ## engine rate table (see benchmarks/engine_rate.py --help)
 	$(PY) benchmarks/engine_rate.py
+
+speed: $(STAMP)  ## sim beside the C code of the fastest design, in one session, into docs/results/
+	$(PY) benchmarks/peer_speed.py --n 10000 100000 1000000 --phi 0.5 \
+		--json $(RESULTS)/speed.json --markdown $(RESULTS)/speed.md
+
+readme: $(STAMP)  ## the README's numbers made anew from docs/results/
+	$(PY) docs/readme.py
+
+docs: $(STAMP)  ## the documentation site into outputs/site (mkdocs, warnings are errors)
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --quiet
 
 lint: $(STAMP)  ## ruff over the sources and tests
 	$(VENV)/bin/ruff check src tests benchmarks

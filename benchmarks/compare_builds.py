@@ -9,9 +9,9 @@ is the mean rate of a build's workers over that of the first build's workers; th
 quartiles over rounds are printed.
 
 A source tree is a directory with ``src/sim`` and ``benchmarks/engine_rate.py`` (a clone or
-``git worktree add ../base <commit>``), optionally followed by ``:<shell diameter r_n/σ>``:
+``git worktree add "$BASE" <commit>``), optionally followed by ``:<shell diameter r_n/σ>``:
 
-    python benchmarks/compare_builds.py ../base . --n 1000000 --chunk 400000 --rounds 16
+    python benchmarks/compare_builds.py "$BASE" . --n 1000000 --chunk 400000 --rounds 16
     python benchmarks/compare_builds.py . .:2.2 --n 1000000   # one build, two shells
 """
 

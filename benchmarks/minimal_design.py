@@ -10,8 +10,8 @@ the packing fraction unless ``--shell`` is given).
 
 Both engines start from the same equilibrated state and run in alternating chunks in one
 process, so that a busy machine slows both alike; the ratio of their rates is what this
-prints. On a quiet machine the minimal engine runs at the speed the fastest C code reaches
-(../shared/performance-notes.md), so the ratio also says how far sim is from it.
+prints. The minimal engine is the design without sim's features, so the ratio is what they
+cost (or, at large N, what sim's memory layout gains).
 
     python benchmarks/minimal_design.py --n 10000 100000 --phi 0.5
 """

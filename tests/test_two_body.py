@@ -1,4 +1,4 @@
-"""Two disks against closed-form results (physics.md, "Two-body collisions")."""
+"""Two disks against closed-form results (docs/physics.md, "Two-body collisions")."""
 
 import math
 

@@ -23,7 +23,7 @@ def dilute_gas(n=200, phi=0.05, seed=1, **options):
 
 def test_thermal_walls_bring_an_elastic_gas_to_their_temperature():
     """Elastic disks between walls at T_w reach equilibrium at T_w: energies m v²/2 are
-    exponential with mean T_w (physics.md, Maxwell–Boltzmann in 2D)."""
+    exponential with mean T_w (docs/physics.md, "Maxwell–Boltzmann in two dimensions")."""
     engine = dilute_gas(walls=ALL_THERMAL, seed=3)
     engine.run(collisions=20_000)
     energies = []
@@ -77,8 +77,8 @@ def test_thermal_draws_are_reproducible_and_survive_a_restart():
 
 def test_slow_piston_compresses_a_dilute_gas_adiabatically():
     """Quasi-static adiabatic compression: N dT = −P dA with P = N T Z/A gives
-    d ln T = −Z d ln A; with the low-density Z = 1 + 2φ (physics.md, B₂) and the area open to
-    disk centres, (Lx − 2R)(Ly − 2R), halving the box takes T to
+    d ln T = −Z d ln A; with the low-density Z = 1 + 2φ (docs/physics.md, the second virial
+    coefficient) and the area open to disk centres, (Lx − 2R)(Ly − 2R), halving the box takes T to
     (A₀'/A₁') exp(2(φ₁ − φ₀)) T₀ = 2.106 T₀ here (2 for a point-particle ideal gas, γ = 2).
     The energy gained is the piston's work to round-off."""
     speed, n = -0.02, 200

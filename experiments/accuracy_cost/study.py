@@ -333,8 +333,12 @@ def pareto(datasets, out):
 
 
 def summary(datasets):
+    """The Markdown table of every knob's settings, errors and seconds, and the reference
+    each knob's error is taken against."""
     lines = ["| knob | setting | error | ± (2σ) | seconds |", "| --- | --- | --- | --- | --- |"]
+    references = []
     for ds in datasets:
+        references.append(f"- `{ds.attrs['knob']}`: {ds.attrs['reference']}")
         if ds.attrs["knob"] == "snapshot_cadence":
             for k in range(ds.sizes["setting"]):
                 lines.append(f"| snapshot_cadence (collisions between snapshots) | "
@@ -346,8 +350,9 @@ def summary(datasets):
             collapsed = " (collapses)" if ds.get("collapsed", np.zeros(k + 1))[k] else ""
             lines.append(f"| {ds.attrs['knob']} ({ds.attrs['unit']}) | "
                          f"{ds['setting'].values[k]:g}{collapsed} | {ds['error'].values[k]:.3g} | "
-                         f"{bar:.2g} | {ds['seconds'].values[k]:.2f} |")
-    return "\n".join(lines) + "\n"
+                         f"{'' if math.isnan(bar) else f'{bar:.2g}'} | "
+                         f"{ds['seconds'].values[k]:.2f} |")
+    return "\n".join(lines + ["", "References:", "", *references]) + "\n"
 
 
 def warm_up():

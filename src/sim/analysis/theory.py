@@ -54,7 +54,7 @@ def maxwell_speed_cdf(v, mass, temperature):
 
 def garzo_dufty_cooling_rates(temperatures, masses, fractions, restitution):
     """Cooling rates ζ_i of a 2D binary mixture of equal-size disks, up to a common factor
-    (Garzó & Dufty, Phys. Rev. E 60, 5706 (1999); physics.md, "Binary mixture"):
+    (Garzó & Dufty, Phys. Rev. E 60, 5706 (1999); docs/physics.md, "Binary mixtures"):
     ζ_i ∝ Σ_j x_j μ_ji (1 + ξ) √(T_i/m_i + T_j/m_j) [1 − ½ μ_ji (1 + ξ)(1 + m_i T_j/(m_j T_i))]
     with μ_ji = m_j / (m_i + m_j)."""
     T, m, x, xi = (np.asarray(a, dtype=float) for a in (temperatures, masses, fractions,

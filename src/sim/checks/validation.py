@@ -80,7 +80,7 @@ def equation_of_state(phi, n=2000, warmup=200, blocks=20, collisions_per_block=2
     collision frequency against Enskog's with the same run's χ = (Z − 1)/(2φ).
 
     Tolerances: four standard errors of the block means, plus 0.6 % for Henderson's formula
-    at φ ≤ 0.5 (physics.md: good to about 0.5 %) — compared only there — and 1/N relative for
+    at φ ≤ 0.5 (docs/physics.md: good to about 0.5 %) — compared only there — and 1/N relative for
     the finite box against the Kolafa–Rottner limit.
     """
     started = time.perf_counter()
@@ -274,7 +274,7 @@ def tc_model(restitution=0.8, n=4000, phi=0.1, seed=5):
 
 def two_body(cases=1000, seed=11):
     """Random binary collisions — masses log-uniform over 10⁻³ … 10³, impact parameter
-    b/a ∈ [0, 0.99], ξ ∈ [0, 1] — against the closed forms (physics.md): the recoil of the
+    b/a ∈ [0, 0.99], ξ ∈ [0, 1] — against the closed forms (docs/physics.md): the recoil of the
     target (speed J/m₂ along the line of centres, J = (1 + ξ) μ v cos α), the energy lost
     (1 − ξ²) μ (v cos α)²/2 and, when elastic, the projectile's scattering angle
     tan θ₁ = sin χ/(m₁/m₂ + cos χ). The largest relative error of all must stay below 1e-12."""
@@ -304,7 +304,7 @@ def two_body(cases=1000, seed=11):
             errors.append(math.remainder(math.atan2(v1[1], v1[0]) - theta1, 2.0 * math.pi))
         worst = max(worst, *(abs(e) for e in errors))
     return [Check(f"two-body: worst relative error of {cases} random collisions", worst, 0.0,
-                  1e-12, "closed forms (physics.md)", time.perf_counter() - started)]
+                  1e-12, "closed forms (docs/physics.md)", time.perf_counter() - started)]
 
 
 # -- gravity and walls ------------------------------------------------------------------------

@@ -17,7 +17,7 @@ E = m v₀²/2 + m g (y₀ − R − surface). A power law A ∝ E^β is fitted 
 runs whose cavity covers at least one grid cell, and again over those whose cavity is larger
 than the projectile's own area πR² (smaller ones are shaped by the projectile's size and the
 grid more than by the energy). In 2D the gravity regime with energy scaling
-(the cavity's mass lifted by its own depth, E ~ ρ g R³) gives β = 2/3 (physics.md,
+(the cavity's mass lifted by its own depth, E ~ ρ g R³) gives β = 2/3 (docs/physics.md,
 "Cratering"); momentum scaling gives smaller exponents.
 """
 

@@ -1,5 +1,5 @@
-"""Figure 4: a gas of 10 000 disks after 100 000 events (10 per disk), the disks drawn to
-scale and coloured by speed, and its kinetic energy against events (elastic: constant to
+"""Figure 4: a gas of 10 000 disks after 100 000 contacts (10 per disk), the disks drawn to
+scale and coloured by speed, and its kinetic energy against contacts (elastic: constant to
 round-off)."""
 
 import numpy as np
@@ -22,10 +22,8 @@ def runs(quick):
 
 def draw(runs, sweeps, out_dir):
     with open_run(runs["gas"]) as ds:
-        events = ds["step"].values
-        events_wanted = 10 * ds.sizes["disk"]
-        k = int(np.searchsorted(events, events_wanted))
-        k = min(k, events.size - 1)
+        contacts = ds["step"].values
+        k = min(int(np.searchsorted(contacts, 10 * ds.sizes["disk"])), contacts.size - 1)
         position = ds["position"].isel(time=k).values
         velocity = ds["velocity"].isel(time=k).values
         radius = ds["radius"].values
@@ -38,12 +36,12 @@ def draw(runs, sweeps, out_dir):
     fig.colorbar(disks, ax=left, label="speed (box units / time)")
     left.grid(False)
     left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xlabel="x (box units)",
-             ylabel="y (box units)", title=f"{n} disks after {events[k]} events")
-    right.plot(events, energy / energy[0] - 1.0, color="C0")
-    right.set(xlabel="events (disk and wall contacts)", ylabel="E / E₀ − 1",
+             ylabel="y (box units)", title=f"{n} disks after {contacts[k]} contacts")
+    right.plot(contacts, energy / energy[0] - 1.0, color="C0")
+    right.set(xlabel="contacts (disk–disk and disk–wall)", ylabel="E / E₀ − 1",
               title=f"kinetic energy: max |E/E₀ − 1| = "
                     f"{np.abs(energy / energy[0] - 1).max():.1e}")
     right.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
-    np.savetxt(out_dir / f"{NAME}.csv", np.column_stack([events, energy]), delimiter=",",
-               header="events,kinetic_energy", comments="")
+    np.savetxt(out_dir / f"{NAME}.csv", np.column_stack([contacts, energy]), delimiter=",",
+               header="contacts,kinetic_energy", comments="")
     return save(fig, out_dir, NAME)

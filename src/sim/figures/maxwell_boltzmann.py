@@ -1,4 +1,4 @@
-"""Figure 5: relaxation to Maxwell–Boltzmann (2D, k_B = 1; physics.md).
+"""Figure 5: relaxation to Maxwell–Boltzmann (2D, k_B = 1; docs/physics.md).
 
 Left: mean speed against collisions, with the equilibration point found automatically — the
 first snapshot after which the mean speed stays within four standard deviations of its

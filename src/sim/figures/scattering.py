@@ -3,7 +3,7 @@
 The scattering angle θ of the projectile against the impact parameter b, for a target 10⁶
 times heavier (the fixed-scatterer law b = a cos(θ/2), a the contact distance) and 3 times
 heavier (the exact finite-mass curve: b = a cos(χ/2) for the centre-of-mass angle χ, and
-tan θ = sin χ / (m₁/m₂ + cos χ); physics.md, "Two-body collisions").
+tan θ = sin χ / (m₁/m₂ + cos χ); docs/physics.md, "Two-body collisions").
 """
 
 import numpy as np

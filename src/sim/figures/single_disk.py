@@ -15,8 +15,8 @@ NAME = "fig01_single_disk"
 
 
 def runs(quick):
-    events, every = (1000, 0.5) if quick else (10_000, 0.1)
-    return {"single_disk": ["scenario=single_disk", f"stop.contacts={events}",
+    contacts, every = (1000, 0.5) if quick else (10_000, 0.1)
+    return {"single_disk": ["scenario=single_disk", f"stop.contacts={contacts}",
                             f"output.every_time={every}"]}
 
 

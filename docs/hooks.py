@@ -1,0 +1,74 @@
+"""MkDocs hooks: the pages made from the code and from what the make targets wrote.
+
+- ``configuration.md``: every scene and config key, from the schema and the comments of
+  ``conf/config.yaml`` (:func:`sim.pipeline.reference.markdown`, the text of ``--help``).
+- ``figures.md``: the gallery, one section per figure stage of :mod:`sim.figures` (its
+  docstring), with the image and the numbers that ``make figures`` wrote into
+  ``outputs/figures/`` when they are there (``QUICK=1`` versions otherwise).
+"""
+
+import csv
+import importlib
+import io
+import re
+import sys
+from pathlib import Path
+
+from mkdocs.structure.files import File
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+FIGURES = ROOT / "outputs" / "figures"
+#: number files at most this large are shown as tables in the gallery (bytes)
+LARGEST_TABLE = 4000
+#: a Sphinx cross-reference in a docstring, ``:func:`name` ``, shown as code
+ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
+
+
+def on_files(files, config):
+    from sim.pipeline.reference import markdown
+
+    files.append(File.generated(config, "configuration.md", content=markdown()))
+    page, images = gallery()
+    files.append(File.generated(config, "figures.md", content=page))
+    for name, path in images:
+        files.append(File.generated(config, f"figures/{name}", abs_src_path=str(path)))
+    return files
+
+
+def gallery():
+    """The gallery page and the images it shows, as (site name, file) pairs."""
+    from sim.figures import STAGES
+
+    lines = [(ROOT / "docs" / "gallery-intro.md").read_text()]
+    images = []
+    for stage_name in STAGES:
+        stage = importlib.import_module(f"sim.figures.{stage_name}")
+        title, _, text = stage.__doc__.partition(":")
+        lines += [f"## {title.strip()}", "", ROLE.sub(r"`\1`", text.strip()), ""]
+        folder = next((f for f in (FIGURES, FIGURES / "quick")
+                       if (f / f"{stage.NAME}.png").exists()), None)
+        if folder is None:
+            if stage_name != "movies":
+                lines += ["*Not made yet here: `make figures` (or `make figures QUICK=1`).*", ""]
+            continue
+        quick = " (quick version)" if folder.name == "quick" else ""
+        images.append((f"{stage.NAME}.png", folder / f"{stage.NAME}.png"))
+        lines += [f"![{title.strip()}{quick}](figures/{stage.NAME}.png)", ""]
+        for numbers in sorted(folder.glob(f"{stage.NAME}*.txt")) + sorted(
+                folder.glob(f"{stage.NAME}*.csv")):
+            if numbers.stat().st_size <= LARGEST_TABLE:
+                lines += [f"`{numbers.name}`{quick}:", "", as_markdown(numbers), ""]
+    return "\n".join(lines), images
+
+
+def as_markdown(path):
+    """A CSV file as a Markdown table; a text file as a code block."""
+    text = path.read_text()
+    if path.suffix != ".csv":
+        return f"```\n{text.rstrip()}\n```"
+    rows = list(csv.reader(io.StringIO(text)))
+    table = ["| " + " | ".join(rows[0]) + " |", "|" + " --- |" * len(rows[0])]
+    table += ["| " + " | ".join(row) + " |" for row in rows[1:]]
+    return "\n".join(table)

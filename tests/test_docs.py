@@ -1,0 +1,94 @@
+"""The README and the docs: short, standing alone, and quoting only numbers that a make target
+wrote (``docs/results/``), so that none can go stale."""
+
+import importlib.util
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = "docs/results/"
+#: an include of pymdownx.snippets: --8<-- "path"
+INCLUDE = re.compile(r'^--8<-- "([^"]+)"', re.M)
+#: a path going up out of the folder it is written in (``.../`` in an elided path is not one)
+UP = re.compile(r"(?<![.\w])\.\./")
+
+
+def readme_module():
+    spec = importlib.util.spec_from_file_location("readme", ROOT / "docs" / "readme.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def written_by_make():
+    """The files under docs/results/ that a recipe of the Makefile writes (``$(RESULTS)/x``)."""
+    makefile = (ROOT / "Makefile").read_text()
+    recipes = "\n".join(line for line in makefile.splitlines() if line.startswith("\t"))
+    return {RESULTS + name for name in re.findall(r"\$\(RESULTS\)/([\w.\-]+)", recipes)}
+
+
+def doc_texts():
+    """(path, text) of the README, the top-level Markdown files and every page and notebook
+    under docs/."""
+    paths = [ROOT / "README.md", ROOT / "ARCHITECTURE.md", ROOT / "CHANGELOG.md"]
+    paths += sorted((ROOT / "docs").rglob("*.md")) + sorted((ROOT / "docs").rglob("*.ipynb"))
+    return [(p.relative_to(ROOT).as_posix(), p.read_text()) for p in paths if p.exists()]
+
+
+def test_the_readme_reads_in_five_minutes():
+    assert (ROOT / "README.md").stat().st_size <= 10 * 1024
+
+
+def test_nothing_points_outside_the_repository():
+    sources = [(p.relative_to(ROOT).as_posix(), p.read_text())
+               for folder in ("src", "benchmarks", "experiments", "conf", "docs")
+               for p in sorted((ROOT / folder).rglob("*"))
+               if p.suffix in (".py", ".yaml", ".c") and "__pycache__" not in p.parts]
+    outside = [f"{path}: {line.strip()}" for path, text in doc_texts() + sources
+               for line in text.splitlines() if UP.search(line)]
+    assert not outside, "\n".join(outside)
+
+
+def test_the_docs_cite_only_results_a_make_target_writes():
+    written = written_by_make()
+    assert written, "no recipe of the Makefile writes into docs/results/"
+    cited = {(path, name) for path, text in doc_texts()
+             for name in re.findall(r"docs/results/[\w.\-]+", text)}
+    unwritten = sorted(f"{path} cites {name}" for path, name in cited if name not in written)
+    assert not unwritten, "\n".join(unwritten)
+
+
+def test_the_docs_include_only_files_that_exist():
+    """An include is a results file a target writes, or a file of the repository outside
+    outputs/ (ARCHITECTURE.md, CHANGELOG.md)."""
+    written = written_by_make()
+    for path, text in doc_texts():
+        for name in INCLUDE.findall(text):
+            assert (ROOT / name).is_file(), f"{path} includes {name}, which is not there"
+            assert not name.startswith("outputs/"), f"{path} includes {name} from outputs/"
+            if name.startswith(RESULTS):
+                assert name in written, f"{path} includes {name}, which no target writes"
+
+
+def test_every_results_file_is_written_by_a_target():
+    written = written_by_make()
+    present = {p.relative_to(ROOT).as_posix() for p in (ROOT / RESULTS).iterdir()}
+    assert present <= written, f"not written by any make target: {sorted(present - written)}"
+
+
+def test_the_readme_numbers_are_those_of_the_results():
+    readme = readme_module()
+    text = readme.README.read_text()
+    names = re.findall(r"<!-- results: (\S+) -->", text)
+    assert sorted(names) == sorted(readme.REGIONS)
+    assert readme.rendered(text) == text, "README.md is stale: run `make readme`"
+
+
+@pytest.mark.parametrize("text, count, passed", [
+    ("| a | pass |\n| --- | --- |\n| x | pass |\n| y | FAIL |\n", 2, 1),
+    ("| a | pass |\n| --- | --- |\n", 0, 0)])
+def test_the_validation_headline_counts_rows(text, count, passed):
+    line = readme_module().validation(text)
+    assert f"compared {count} measurements" in line and f": {passed} within" in line
