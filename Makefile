@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: help venv run test validate bench figures accuracy lint clean
+.PHONY: help venv run test validate tutorials bench figures accuracy lint clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -25,6 +25,9 @@ test: $(STAMP)  ## quick tests (long physics runs are marked slow), one worker p
 
 validate: $(STAMP)  ## every test, slow physics runs included; writes outputs/validation/table.md
 	$(PY) -m pytest -q -m ""
+
+tutorials: $(STAMP)  ## run the tutorial notebooks (nbmake)
+	$(PY) -m pytest -q -p no:cacheprovider --nbmake --nbmake-timeout=600 docs/tutorials
 
 figures: $(STAMP)  ## every figure into outputs/figures/ (QUICK=1: small versions)
 	$(PY) -m sim.figures $(if $(QUICK),--quick)
