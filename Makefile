@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 # the results the docs and the README include; only the targets below write them
 RESULTS := docs/results
 
-.PHONY: help venv run test validate bench speed figures accuracy readme docs lint clean
+.PHONY: help venv run test validate tutorials bench speed figures accuracy readme docs lint clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -29,7 +29,7 @@ validate: $(STAMP)  ## every test, slow physics runs included; the table into ou
 	$(PY) -m pytest -q -m ""
 	cp outputs/validation/table.md $(RESULTS)/validation.md
 
-figures: $(STAMP)  ## every figure into outputs/figures/, the README's picture into docs/results/ (QUICK=1: small versions only)
+.PHONY: help venv run test validate tutorials bench speed figures accuracy readme docs lint clean
 	$(PY) -m sim.figures $(if $(QUICK),--quick)
 	$(if $(QUICK),,cp outputs/figures/fig08_crater_grid.png $(RESULTS)/crater.png)
 
