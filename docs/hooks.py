@@ -1,7 +1,7 @@
 """MkDocs hooks: the pages made from the code and from what the make targets wrote.
 
 - ``configuration.md``: every scene and config key, from the schema and the comments of
-  ``conf/config.yaml`` (:func:`sim.pipeline.reference.markdown`, the text of ``--help``).
+  ``conf/config.yaml`` (:func:`sim.pipeline.config_reference.markdown`, the text of ``--help``).
 - ``figures.md``: the gallery, one section per figure stage of :mod:`sim.figures` (its
   docstring), with the image and the numbers that ``make figures`` wrote into
   ``outputs/figures/`` when they are there (``QUICK=1`` versions otherwise).
@@ -24,10 +24,12 @@ FIGURES = ROOT / "outputs" / "figures"
 LARGEST_TABLE = 4000
 #: a Sphinx cross-reference in a docstring, ``:func:`name` ``, shown as code
 ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
+#: the same, as the API reference renders it: the role left before the code
+RENDERED_ROLE = re.compile(r":(?:class|func|meth|mod|data|attr|exc|obj):(<code>)~?")
 
 
 def on_files(files, config):
-    from sim.pipeline.reference import markdown
+    from sim.pipeline.config_reference import markdown
 
     files.append(File.generated(config, "configuration.md", content=markdown()))
     page, images = gallery()
@@ -35,6 +37,11 @@ def on_files(files, config):
     for name, path in images:
         files.append(File.generated(config, f"figures/{name}", abs_src_path=str(path)))
     return files
+
+
+def on_page_content(html, page, config, files):
+    """Docstrings write cross-references as Sphinx roles; the page shows the name alone."""
+    return RENDERED_ROLE.sub(r"\1", html)
 
 
 def gallery():

@@ -1,5 +1,5 @@
-"""The typed configuration of a scene: dataclasses registered in Hydra's ConfigStore, and
-the range checks that types cannot express.
+"""The typed configuration of a scene: the schema (:mod:`sim.pipeline.schema`) registered in
+Hydra's ConfigStore, and the range checks that types cannot express.
 
 Hydra rejects unknown keys and wrong types when it composes the config; :func:`validate`
 then checks every value against what is allowed and raises :class:`ConfigError` naming the
@@ -11,11 +11,11 @@ checks of each scene's own keys, are :data:`sim.pipeline.scenes.SCENES`.
 
 import math
 import warnings
-from dataclasses import dataclass, field, fields, is_dataclass
-from typing import Any, Optional
+from dataclasses import fields, is_dataclass
+from typing import Any
 
 from hydra.core.config_store import ConfigStore
-from omegaconf import MISSING, DictConfig, OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from sim.effects import check_config
 from sim.pipeline.initial import RSA_JAMMING
@@ -31,171 +31,7 @@ from sim.pipeline.input_checks import (
     within,
 )
 from sim.pipeline.scenes import SCENES
-
-
-@dataclass
-class BoxConfig:
-    size: list = field(default_factory=lambda: [1.0, 1.0])
-    boundary: str = "walls"
-
-
-@dataclass
-class DisksConfig:
-    n: int = 2000
-    radius: Optional[float] = None
-    packing_fraction: Optional[float] = None
-    mass: float = 1.0
-    speed: Optional[float] = 1.0
-    temperature: Optional[float] = None
-    placement: str = "auto"
-    zero_momentum: bool = False
-    inertia_factor: float = 0.5
-    rotational_temperature: float = 0.0
-
-
-@dataclass
-class RestitutionConfig:
-    disk: float = 1.0
-    wall: float = 1.0
-    tangential: float = -1.0
-    wall_tangential: float = -1.0
-
-
-@dataclass
-class FrictionConfig:
-    mu: Optional[float] = None
-    wall_mu: Optional[float] = None
-
-
-@dataclass
-class WallConfig:
-    temperature: Optional[float] = None
-    speed: float = 0.0
-    amplitude: float = 0.0
-    frequency: float = 0.0
-
-
-@dataclass
-class WallsConfig:
-    left: WallConfig = field(default_factory=WallConfig)
-    right: WallConfig = field(default_factory=WallConfig)
-    bottom: WallConfig = field(default_factory=WallConfig)
-    top: WallConfig = field(default_factory=WallConfig)
-
-
-@dataclass
-class TCConfig:
-    time: Optional[float] = None
-
-
-@dataclass
-class StopConfig:
-    collisions: Optional[int] = None
-    contacts: Optional[int] = None
-    events: Optional[int] = None  # the old name of contacts (RENAMED_KEYS)
-    time: Optional[float] = None
-    energy_fraction: Optional[float] = None
-    at_rest: Optional[float] = None
-    wall_seconds: Optional[float] = None
-
-
-@dataclass
-class OutputConfig:
-    every_collisions: Optional[int] = None
-    every_time: Optional[float] = None
-    file: str = "run.h5"
-    progress: bool = True
-
-
-@dataclass
-class RadialDistributionConfig:
-    bins: Optional[int] = None
-    r_max: float = 4.0
-
-
-@dataclass
-class ClustersConfig:
-    gap: Optional[float] = None
-
-
-@dataclass
-class LocalFieldsConfig:
-    cells: Optional[int] = None
-
-
-@dataclass
-class ObserveConfig:
-    radial_distribution: RadialDistributionConfig = field(
-        default_factory=RadialDistributionConfig)
-    clusters: ClustersConfig = field(default_factory=ClustersConfig)
-    local_fields: LocalFieldsConfig = field(default_factory=LocalFieldsConfig)
-    mean_squared_displacement: bool = False
-    velocity_autocorrelation: bool = False
-    pressure_tensor: bool = False
-    event_log: bool = False
-
-
-@dataclass
-class ProjectileConfig:
-    radius: float = 0.05
-    speed: float = 10.0
-    mass: Optional[float] = None
-    position: list = field(default_factory=lambda: [0.5, 0.75])
-
-
-@dataclass
-class BedConfig:
-    n: int = 4000
-    radius: float = 0.0045
-    mass: float = 1.0
-    height: float = 0.5
-    settle_time: Optional[float] = None
-
-
-@dataclass
-class MixtureConfig:
-    masses: list = field(default_factory=lambda: [1.0, 4.0])
-    fractions: list = field(default_factory=lambda: [0.5, 0.5])
-
-
-@dataclass
-class ScatteringConfig:
-    impact_parameter: float = 0.0
-    target_radius: float = 0.1
-    target_mass: float = 1.0e6
-
-
-@dataclass
-class TwoDisksConfig:
-    positions: list = field(default_factory=lambda: [[0.25, 0.5], [0.75, 0.52]])
-    velocities: list = field(default_factory=lambda: [[1.0, 0.3], [-0.5, 0.8]])
-
-
-@dataclass
-class SimConfig:
-    scene: str = MISSING
-    seed: int = 0
-    box: BoxConfig = field(default_factory=BoxConfig)
-    disks: DisksConfig = field(default_factory=DisksConfig)
-    restitution: RestitutionConfig = field(default_factory=RestitutionConfig)
-    tc: TCConfig = field(default_factory=TCConfig)
-    friction: FrictionConfig = field(default_factory=FrictionConfig)
-    gravity: list = field(default_factory=lambda: [0.0, 0.0])
-    walls: WallsConfig = field(default_factory=WallsConfig)
-    stop: StopConfig = field(default_factory=StopConfig)
-    output: OutputConfig = field(default_factory=OutputConfig)
-    observe: ObserveConfig = field(default_factory=ObserveConfig)
-    projectile: Optional[ProjectileConfig] = None
-    bed: Optional[BedConfig] = None
-    mixture: Optional[MixtureConfig] = None
-    scattering: Optional[ScatteringConfig] = None
-    two_disks: Optional[TwoDisksConfig] = None
-    resume: Optional[str] = None
-
-
-#: Keys renamed in this release: old name → new name. The old name still works, with a
-#: FutureWarning, until the next release.
-RENAMED_KEYS = {"stop.events": "stop.contacts"}
+from sim.pipeline.schema import RENAMED_KEYS, SimConfig
 
 
 def renamed_keys(cfg, warn=True):

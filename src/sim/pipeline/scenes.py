@@ -6,7 +6,7 @@ sections it needs, the checks of its own keys, its fixed number of disks if it h
 whether it is a gas filling the box. The config's list of scenes and its per-scene checks
 (:func:`sim.pipeline.config.validate`), :data:`BUILDERS`, :data:`PREPARATIONS` and the
 resource estimates (:mod:`sim.pipeline.resources`) all come from it. Adding a scene is its
-builder and entry here, its section of the schema (:mod:`sim.pipeline.config`) if it has keys
+builder and entry here, its section of the schema (:mod:`sim.pipeline.schema`) if it has keys
 of its own, and ``conf/scenario/<name>.yaml``; ``tests/test_scene_registry.py`` checks that
 they agree. Positions and velocities are float64[n, 2] in box units.
 """
