@@ -5,6 +5,7 @@
 - ``figures.md``: the gallery, one section per figure stage of :mod:`sim.figures` (its
   docstring), with the image and the numbers that ``make figures`` wrote into
   ``outputs/figures/`` when they are there (``QUICK=1`` versions otherwise).
+- every page: the Sphinx roles of the docstrings (``:class:`Engine` ``) shown as the name.
 """
 
 import csv
@@ -52,8 +53,9 @@ def gallery():
     images = []
     for stage_name in STAGES:
         stage = importlib.import_module(f"sim.figures.{stage_name}")
-        title, _, text = stage.__doc__.partition(":")
-        lines += [f"## {title.strip()}", "", ROLE.sub(r"`\1`", text.strip()), ""]
+        text = ROLE.sub(r"`\1`", stage.__doc__.strip())
+        title = heading(text)
+        lines += [f"## {title}", "", text, ""]
         folder = next((f for f in (FIGURES, FIGURES / "quick")
                        if (f / f"{stage.NAME}.png").exists()), None)
         if folder is None:
@@ -62,12 +64,29 @@ def gallery():
             continue
         quick = " (quick version)" if folder.name == "quick" else ""
         images.append((f"{stage.NAME}.png", folder / f"{stage.NAME}.png"))
-        lines += [f"![{title.strip()}{quick}](figures/{stage.NAME}.png)", ""]
+        lines += [f"![{title}{quick}](figures/{stage.NAME}.png)", ""]
         for numbers in sorted(folder.glob(f"{stage.NAME}*.txt")) + sorted(
                 folder.glob(f"{stage.NAME}*.csv")):
             if numbers.stat().st_size <= LARGEST_TABLE:
                 lines += [f"`{numbers.name}`{quick}:", "", as_markdown(numbers), ""]
     return "\n".join(lines), images
+
+
+def heading(docstring):
+    """A stage's heading: the first sentence of its docstring, or, when that is long, its
+    part before the first parenthesis or second colon ("Figure 9: crater area against …")."""
+    sentence = " ".join(re.split(r"\.\s", docstring, maxsplit=1)[0].split())
+    if len(sentence) > 90:
+        sentence = ":".join(sentence.split(" (")[0].split(":")[:2])
+    return sentence.rstrip(".")
+
+
+def number(cell):
+    """A CSV cell as written, or to six significant digits when it is a float."""
+    try:
+        return f"{float(cell):.6g}" if any(c in cell for c in ".eE") else cell
+    except ValueError:
+        return cell
 
 
 def as_markdown(path):
@@ -77,5 +96,5 @@ def as_markdown(path):
         return f"```\n{text.rstrip()}\n```"
     rows = list(csv.reader(io.StringIO(text)))
     table = ["| " + " | ".join(rows[0]) + " |", "|" + " --- |" * len(rows[0])]
-    table += ["| " + " | ".join(row) + " |" for row in rows[1:]]
+    table += ["| " + " | ".join(number(cell) for cell in row) + " |" for row in rows[1:]]
     return "\n".join(table)
