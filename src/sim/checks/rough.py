@@ -98,8 +98,8 @@ def rough_cooling(restitution, roughness, n=1000, phi=0.05, seed=71, runs=8):
     later do not count as heat. Tolerances: four standard errors of the mean of the runs,
     plus 4 % for the theory: its Maxwellian closure neglects the fourth cumulants, which the
     Sonine analyses of Santos and co-workers find to move r by a few per cent. The more
-    dissipative the gas, the sooner its shear modes and clusters grow within C/N = 6, and
-    the further below r the measured ratio falls (the validation table has the values).
+    dissipative the gas, the sooner its shear modes and clusters grow within C/N = 6 (the
+    validation table has the measured ratios).
     """
     started = time.perf_counter()
     reference = rough_disk_temperature_ratio(restitution, roughness, Q)
