@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 # the results the docs and the README include; only the targets below write them
 RESULTS := docs/results
 
-.PHONY: help venv run test validate tutorials bench speed figures accuracy readme docs lint clean
+.PHONY: help venv run test validate tutorials bench speed figures accuracy readme docs lint wheel clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -53,6 +53,18 @@ docs: $(STAMP)  ## the documentation site into outputs/site (mkdocs, warnings ar
 lint: $(STAMP)  ## ruff over the sources and tests
 	$(VENV)/bin/ruff check src tests benchmarks
 
+# the throwaway install compiles into a numba cache of its own, removed with it
+wheel: $(STAMP)  ## build the wheel and run the default scene from it in a fresh venv
+	@set -e; tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
+	$(PY) -m build --outdir "$$tmp/dist" . >"$$tmp/build.log" 2>&1 || { cat "$$tmp/build.log"; exit 1; }; \
+	wheel=$$(ls "$$tmp"/dist/*.whl); echo "built $$(basename "$$wheel")"; \
+	$(PYTHON) -m venv "$$tmp/venv"; \
+	"$$tmp/venv/bin/python" -m pip install --quiet "$$wheel"; \
+	mkdir "$$tmp/work"; cd "$$tmp/work"; \
+	NUMBA_CACHE_DIR="$$tmp/numba" "$$tmp/venv/bin/sim" stop.collisions=20000 \
+		output.progress=false hydra.run.dir=run; \
+	"$$tmp/venv/bin/sim-inspect" run/run.h5
+
 clean:  ## remove the environment, caches and generated outputs
-	rm -rf $(VENV) outputs .pytest_cache build src/*.egg-info
+	rm -rf $(VENV) outputs .pytest_cache build dist src/*.egg-info
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +

@@ -1,4 +1,4 @@
-"""Import paths of the flat layout before 0.2, and of the run cache and crater runs once in
+"""Import paths of the flat layout before 0.1.0, and of the run cache and crater runs once in
 :mod:`sim.figures`, kept for one release: ``import sim.runner`` still gives
 :mod:`sim.pipeline.runner`, with a DeprecationWarning, and ``python -m sim.inspect`` still runs
 :mod:`sim.storage.inspect`."""

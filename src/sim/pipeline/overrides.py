@@ -1,5 +1,6 @@
 """The command line's overrides: integers written as ``2e6`` made whole, a sweep expanded into
-its jobs, configs composed from ``conf/``, and the value of one key read or replaced."""
+its jobs, configs composed from the package's ``conf/``, and the value of one key read or
+replaced."""
 
 import itertools
 import math
@@ -13,7 +14,8 @@ from hydra.core.override_parser.overrides_parser import OverridesParser
 from sim.pipeline.cli_exits import fail, first_line
 from sim.pipeline.config import integer_keys, renamed_keys
 
-CONF_DIR = str((Path(__file__).resolve().parents[3] / "conf"))
+#: the YAML configs, shipped inside the package (the checkout's ``conf`` links here)
+CONF_DIR = str(Path(__file__).resolve().parents[1] / "conf")
 INTEGER_KEYS = frozenset(integer_keys())
 SWEEP_FLAGS = ("-m", "--multirun")
 

@@ -23,8 +23,13 @@ from sim.storage.h5md import DiskFullError, RunWriter, hdf5_reason
 
 
 def _git_commit():
+    """The commit of the checkout sim runs from, or ``unknown``: a repository that does not
+    track this file (an installed copy in a venv inside someone's project) is not sim's."""
+    here = Path(__file__)
     try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
+        subprocess.run(["git", "ls-files", "--error-unmatch", here.name], cwd=here.parent,
+                       capture_output=True, timeout=5, check=True)
+        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=here.parent,
                              capture_output=True, text=True, timeout=5, check=True)
         return out.stdout.strip()
     except (OSError, subprocess.SubprocessError):
