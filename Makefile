@@ -61,6 +61,7 @@ wheel: $(STAMP)  ## build the wheel and run the default scene from it in a fresh
 	$(PYTHON) -m venv "$$tmp/venv"; \
 	"$$tmp/venv/bin/python" -m pip install --quiet "$$wheel"; \
 	mkdir "$$tmp/work"; cd "$$tmp/work"; \
+	"$$tmp/venv/bin/sim" --help | grep -q "rough_cooling"; \
 	NUMBA_CACHE_DIR="$$tmp/numba" "$$tmp/venv/bin/sim" stop.collisions=20000 \
 		output.progress=false hydra.run.dir=run; \
 	"$$tmp/venv/bin/sim-inspect" run/run.h5

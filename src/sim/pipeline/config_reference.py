@@ -32,9 +32,9 @@ from pathlib import Path
 
 import yaml
 
-from sim.pipeline.schema import RENAMED_KEYS, SimConfig
+from sim.pipeline.schema import CONF_DIR, RENAMED_KEYS, SimConfig
 
-CONF = Path(__file__).resolve().parents[3] / "conf"
+CONF = Path(CONF_DIR)
 #: keys set by the scenario files, not by hand (``scenario=NAME`` chooses them)
 SET_BY_SCENARIO = ("scene",)
 #: sections of ``conf/config.yaml`` that are not keys of a scene
@@ -381,9 +381,9 @@ def text(width=None):
         lines += ["", paragraph(f"{section.name or 'top level'}{where}{about}")]
         for k in section.keys:
             lines += row(f"  {k.name}={k.default}", k.meaning, column)
-    docs = ", ".join(path.name for path in sorted((CONF.parent / "docs").glob("*.md")))
-    lines += ["", paragraph(f"More: README.md, ARCHITECTURE.md and docs/ ({docs}). This "
-                            f"reference as a Markdown page:"),
+    lines += ["", paragraph("More: the documentation (`make docs` in a clone builds it from "
+                            "docs/), README.md and ARCHITECTURE.md. This reference as a "
+                            "Markdown page:"),
               "  python -m sim.pipeline.config_reference --markdown"]
     return "\n".join(lines)
 

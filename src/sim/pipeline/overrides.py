@@ -6,16 +6,14 @@ import itertools
 import math
 import re
 from collections import OrderedDict
-from pathlib import Path
 
 from hydra import compose, initialize_config_dir
 from hydra.core.override_parser.overrides_parser import OverridesParser
 
 from sim.pipeline.cli_exits import fail, first_line
 from sim.pipeline.config import integer_keys, renamed_keys
+from sim.pipeline.schema import CONF_DIR
 
-#: the YAML configs, shipped inside the package (the checkout's ``conf`` links here)
-CONF_DIR = str(Path(__file__).resolve().parents[1] / "conf")
 INTEGER_KEYS = frozenset(integer_keys())
 SWEEP_FLAGS = ("-m", "--multirun")
 

@@ -7,9 +7,13 @@ sim --help``) reads it without loading the compiled engine.
 """
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Optional
 
 from omegaconf import MISSING
+
+#: the YAML of the scenes, shipped in the package (``conf/`` at the top of a clone links here)
+CONF_DIR = str(Path(__file__).resolve().parents[1] / "conf")
 
 
 @dataclass
