@@ -29,7 +29,10 @@ validate: $(STAMP)  ## every test, slow physics runs included; the table into ou
 	$(PY) -m pytest -q -m ""
 	cp outputs/validation/table.md $(RESULTS)/validation.md
 
-.PHONY: help venv run test validate tutorials bench speed figures accuracy readme docs lint clean
+tutorials: $(STAMP)  ## run the tutorial notebooks (nbmake)
+	$(PY) -m pytest -q -p no:cacheprovider --nbmake --nbmake-timeout=600 docs/tutorials
+
+figures: $(STAMP)  ## every figure into outputs/figures/, the README's picture into docs/results/ (QUICK=1: small versions only)
 	$(PY) -m sim.figures $(if $(QUICK),--quick)
 	$(if $(QUICK),,cp outputs/figures/fig08_crater_grid.png $(RESULTS)/crater.png)
 
