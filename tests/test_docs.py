@@ -101,3 +101,30 @@ def test_every_make_target_the_docs_name_exists():
              for target in re.findall(r"`make ([a-z]+)", text)}
     missing = sorted(f"{path}: make {target}" for path, target in named if target not in targets)
     assert not missing, "\n".join(missing)
+
+
+def python_examples():
+    """(page, code) of every Python block of the README and the getting-started page."""
+    return [(name, code) for name in ("README.md", "docs/getting-started.md")
+            for code in re.findall(r"```python\n(.*?)```", (ROOT / name).read_text(), re.S)]
+
+
+@pytest.mark.parametrize("page, code", python_examples(),
+                         ids=[f"{name}-{k}" for k, (name, _) in enumerate(python_examples())])
+def test_the_python_examples_run(page, code, tmp_path):
+    """Each example runs as printed; a run file it opens (``outputs/runs/DATE/TIME/run.h5``)
+    is one the test makes, and its wall budget is widened so that a loaded machine cannot
+    end the run before the stop the example claims."""
+    from sim.pipeline.run_cache import compose_config
+    from sim.pipeline.runner import run
+
+    placeholder = "outputs/runs/DATE/TIME/run.h5"
+    if placeholder in code:
+        path = run(compose_config(["disks.n=200", "stop.collisions=2000",
+                                   "output.progress=false"]), tmp_path)
+        code = code.replace(placeholder, str(path))
+    namespace = {}
+    exec(compile(code.replace("wall_seconds=60", "wall_seconds=3600"), page, "exec"), namespace)
+    claimed = re.search(r"reason = .*# -> \"(\w+)\"", code)
+    if claimed:
+        assert namespace["reason"] == claimed.group(1)
