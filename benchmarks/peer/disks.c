@@ -37,6 +37,7 @@
  * centre-of-mass frame, T = K / N), and (E - E_0) / E_0.
  */
 #define _POSIX_C_SOURCE 200112L
+#define _DEFAULT_SOURCE        /* glibc: MADV_HUGEPAGE */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
