@@ -11,7 +11,8 @@ runs one chunk of collisions, in a shuffled order (as ``compare_builds.py`` does
 it itself (C with CLOCK_MONOTONIC, Python with perf_counter). Printed per (N, φ): the
 best-chunk rate of each (the rate the machine disturbed least) and the median and quartiles
 over rounds of the same-round ratio sim / C; ``--json PATH`` writes the rows with the machine,
-the versions, the date and the command.
+the versions, the date and the command, and ``--markdown PATH`` the table with a line saying
+where and how it was measured (``make speed`` writes both into ``docs/results/``).
 
     python benchmarks/peer_speed.py --n 10000 100000 --phi 0.5 --rounds 6
     python benchmarks/peer_speed.py --minimal --json outputs/peer_speed.json
@@ -178,6 +179,8 @@ def main(argv=None):
                         help="folder for the C build and state files (default: a temporary one)")
     parser.add_argument("--json", metavar="PATH", default=None,
                         help="also write the rows and the machine to this JSON file")
+    parser.add_argument("--markdown", metavar="PATH", default=None,
+                        help="also write the table and how it was measured to this file")
     parser.add_argument("--worker", choices=["sim", "minimal"], help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
@@ -189,11 +192,11 @@ def main(argv=None):
         folder = Path(args.build_dir or scratch)
         folder.mkdir(parents=True, exist_ok=True)
         executable = build_peer(folder)
-        header = ["n", "phi", "shell", "C", "sim", "sim / C", "quartiles"]
+        header = ["N", "φ", "shell r_n/σ", "C", "sim", "sim / C", "quartiles"]
         if args.minimal:
             header += ["minimal", "minimal / C", "quartiles"]
-        print(" | ".join(header))
-        print(" | ".join("---" for _ in header))
+        table = [f"| {' | '.join(header)} |", f"|{' --- |' * len(header)}"]
+        print("\n".join(table))
         rows = []
         for n in args.n:
             for phi in args.phi:
@@ -205,13 +208,22 @@ def main(argv=None):
                     cells += [f"{row[f'{kind}_collisions_per_s'] / 1e6:.3f} M",
                               row[f"{kind}_over_c"],
                               f"{row[f'{kind}_over_c_q1']}–{row[f'{kind}_over_c_q3']}"]
-                print(" | ".join(str(c) for c in cells), flush=True)
-    print(f"\nrates: best chunk of {args.rounds} rounds of {args.chunk} collisions; ratios: "
-          "median and quartiles over rounds of the same-round ratio")
+                table.append(f"| {' | '.join(str(c) for c in cells)} |")
+                print(table[-1], flush=True)
+    about = machine()
+    note = (f"Rates: the best chunk of {args.rounds} rounds of {args.chunk} collisions, one "
+            f"thread; ratios: median and quartiles over rounds of the same-round ratio. "
+            f"Measured {about['date'][:10]} on {about['processor']} ({about['cores']} cores), "
+            f"Python {about['python']}, numba {about['numba']}, {about['compiler']} "
+            f"{about['flags']}, with `{about['command']}`.")
+    print(f"\n{note}")
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps({"machine": machine(), "rows": rows}, indent=1)
+        Path(args.json).write_text(json.dumps({"machine": about, "rows": rows}, indent=1)
                                    + "\n")
+    if args.markdown:
+        Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.markdown).write_text("\n".join(table) + f"\n\n{note}\n")
 
 
 if __name__ == "__main__":
