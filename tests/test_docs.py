@@ -128,3 +128,14 @@ def test_the_python_examples_run(page, code, tmp_path):
     claimed = re.search(r"reason = .*# -> \"(\w+)\"", code)
     if claimed:
         assert namespace["reason"] == claimed.group(1)
+
+
+def test_every_page_the_code_and_docs_cite_exists():
+    """A docstring, comment or page that names ``docs/<page>.md`` names a page there is."""
+    texts = doc_texts() + [(p.relative_to(ROOT).as_posix(), p.read_text())
+                           for folder in ("src", "tests", "benchmarks", "experiments")
+                           for p in sorted((ROOT / folder).rglob("*.py"))]
+    cited = {(path, page) for path, text in texts
+             for page in re.findall(r"docs/[\w\-/]+\.md", text)}
+    missing = sorted(f"{path}: {page}" for path, page in cited if not (ROOT / page).is_file())
+    assert not missing, "\n".join(missing)
