@@ -5,6 +5,8 @@
 - ``figures.md``: the gallery, one section per figure stage of :mod:`sim.figures` (its
   docstring), with the image and the numbers that ``make figures`` wrote into
   ``outputs/figures/`` when they are there (``QUICK=1`` versions otherwise).
+- ``api/engine.md``: the table of the effects' Engine keywords (each effect module's
+  ``KEYWORDS``), which the Engine's docstring gains only when the module is imported.
 - every page: the Sphinx roles of the docstrings (``:class:`Engine` ``) shown as the name.
 """
 
@@ -21,6 +23,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 FIGURES = ROOT / "outputs" / "figures"
+#: where api/engine.md shows the effects' keywords
+EFFECT_KEYWORDS = "<!-- effect keywords -->"
 #: number files at most this large are shown as tables in the gallery (bytes)
 LARGEST_TABLE = 4000
 #: a Sphinx cross-reference in a docstring, ``:func:`name` ``, shown as code
@@ -38,6 +42,24 @@ def on_files(files, config):
     for name, path in images:
         files.append(File.generated(config, f"figures/{name}", abs_src_path=str(path)))
     return files
+
+
+def on_page_markdown(markdown, page, config, files):
+    """The effects' keywords where ``api/engine.md`` asks for them."""
+    return markdown.replace(EFFECT_KEYWORDS, effect_keywords())
+
+
+def effect_keywords():
+    """Every effect's Engine keywords: keyword, default, meaning, and the effect's module."""
+    from sim.effects import EFFECTS
+
+    rows = ["| keyword | default | meaning | effect |", "| --- | --- | --- | --- |"]
+    for effect in EFFECTS:
+        name = effect.module.__name__
+        for keyword, (default, meaning) in effect.module.KEYWORDS.items():
+            cell = ROLE.sub(r"`\1`", meaning).replace("|", "\\|")
+            rows.append(f"| `{keyword}` | `{default!r}` | {cell} | `{name}` |")
+    return "\n".join(rows)
 
 
 def on_page_content(html, page, config, files):
