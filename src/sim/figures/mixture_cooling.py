@@ -27,8 +27,8 @@ from sim.figures.style import figure, save
 
 NAME = "fig07_mixture_cooling"
 RESTITUTION = (1.0, 0.9, 0.8)
-#: collisions per disk over which a run's ratio is averaged: the homogeneous cooling state
-WINDOW = (10.0, 60.0)
+#: collisions per disk (C/N) over which a run's ratio is averaged: the homogeneous cooling state
+WINDOW = (5.0, 30.0)
 #: disks and packing fraction: N φ = 16, L_c ≥ 1.31 box sides (module docstring)
 DISKS, PACKING = 800, 0.02
 
@@ -47,7 +47,7 @@ def instability_length(restitution, n=DISKS, phi=PACKING, area=1.0):
 
 
 def sweeps(quick):
-    collisions = int(WINDOW[1] * DISKS / 2)
+    collisions = int(WINDOW[1] * DISKS)
     return {"cooling": ["scenario=mixture", "box.boundary=periodic", f"disks.n={DISKS}",
                         f"disks.packing_fraction={PACKING}", "disks.speed=null",
                         "disks.temperature=1.0", "disks.zero_momentum=true", "tc.time=1e-9",
@@ -91,7 +91,7 @@ def draw(runs, sweeps, out_dir):
     # (restitution, seed, snapshot, species): kinetic energy per disk of each species
     temperature = ds["kinetic_energy_by_species"].transpose(
         "restitution_disk", "seed", "snapshot", "species").values / counts
-    per_disk = 2.0 * _first(ds["collisions"], "snapshot") / counts.sum()
+    per_disk = _first(ds["collisions"], "snapshot") / counts.sum()
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     seeds = temperature.shape[1]
     fig, (left, right) = figure(width=10)

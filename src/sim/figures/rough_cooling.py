@@ -9,8 +9,8 @@ T_tr is taken in the frame of the local flow on 4 × 4 cells
 (:func:`sim.analysis.datasets.granular_temperatures`), T_rot = ⟨I ω²⟩, both averaged over the
 runs (seeds) at each snapshot; the ratio's error is the standard error over the runs of each
 run's mean over ``WINDOW``. The more nearly smooth the disks (β → −1), the weaker the coupling
-of spin and translation and the slower the climb (β = −0.5 has not settled after 24 collisions
-per disk, so it is not drawn). The gas is dilute and its box small against the length at which
+of spin and translation and the slower the climb (β = −0.5 has not settled after 12 collisions
+per disk, C/N, so it is not drawn). The gas is dilute and its box small against the length at which
 a cooling gas grows shear and clusters, L_c = 2√π/(n σ √(1 − ξ²)) = 2.3 box sides for
 ξ = 0.9 at N = 500, φ = 0.02 (roughness dissipates more per collision and shortens it
 somewhat), so that it stays homogeneous over the window.
@@ -33,8 +33,8 @@ from sim.figures.style import figure, save
 NAME = "fig12_rough_cooling"
 RESTITUTION = 0.9
 ROUGHNESS = (0.0, 0.5, 1.0)
-#: collisions per disk over which a run's ratio is averaged: the homogeneous cooling state
-WINDOW = (14.0, 24.0)
+#: collisions per disk (C/N) over which a run's ratio is averaged: the homogeneous cooling state
+WINDOW = (7.0, 12.0)
 #: disks and packing fraction: the box is 2.3 clustering lengths of ξ = 0.9 (module docstring)
 DISKS, PACKING = 500, 0.02
 
@@ -45,7 +45,7 @@ def sweeps(quick):
                       f"disks.packing_fraction={PACKING}",
                       f"restitution.disk={RESTITUTION}",
                       "restitution.tangential=" + ",".join(map(str, ROUGHNESS)),
-                      f"stop.collisions={int(WINDOW[1] * DISKS / 2)}",
+                      f"stop.collisions={int(WINDOW[1] * DISKS)}",
                       f"output.every_collisions={DISKS // 4}", f"seed=range(0,{seeds})"]}
 
 
@@ -63,7 +63,7 @@ def temperatures(run, q):
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["rough"])
     q = float(yaml.safe_load(ds["config"].values.flat[0])["disks"]["inertia_factor"])
-    per_disk = 2.0 * ds["collisions"].isel(restitution_tangential=0, seed=0).values / ds.sizes[
+    per_disk = ds["collisions"].isel(restitution_tangential=0, seed=0).values / ds.sizes[
         "disk"]
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     n = ds.sizes["disk"]

@@ -198,7 +198,7 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
 #: Collisions per disk of the elastic run that melts a lattice (:func:`melted_lattice`):
 #: tests/test_initial.py checks that the crater bed's global bond-orientational order |ψ₆|
 #: (0.9 on the lattice) is then a fluid's, below 3/√n.
-MELT_COLLISIONS_PER_DISK = 20
+MELT_COLLISIONS_PER_DISK = 10
 
 #: the stream of random numbers of a melt's velocities, apart from the scene's own
 MELT_STREAM = 7
@@ -208,8 +208,7 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
                    collisions_per_disk=MELT_COLLISIONS_PER_DISK):
     """Positions float64[n, 2] of n disks placed on :func:`hexagonal_lattice` and melted by
     an elastic run confined to the region (Maxwellian velocities at T = 1, zero momentum,
-    ``collisions_per_disk`` collisions per disk, i.e. n × collisions_per_disk / 2 disk–disk
-    collisions): hard walls at the region's edges, periodic along an axis the region spans
+    ``collisions_per_disk`` × n disk–disk collisions): hard walls at the region's edges, periodic along an axis the region spans
     in a periodic box. Deterministic in ``seed``."""
     from sim.engine.core import Engine
     from sim.engine.inputs import Boundary  # the engine prepares, it does not place
@@ -220,7 +219,7 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
     mass = np.ones(n)
     streams = np.random.SeedSequence((seed, MELT_STREAM))
     velocity = remove_drift(maxwellian(mass, 1.0, seed=streams), mass)
-    collisions = round(0.5 * collisions_per_disk * n)
+    collisions = round(collisions_per_disk * n)
     try:
         engine = Engine(position - lo, velocity, radius, mass,
                         boundary=Boundary(size=tuple(float(x) for x in hi - lo),
