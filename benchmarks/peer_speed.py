@@ -192,9 +192,10 @@ def main(argv=None):
         folder = Path(args.build_dir or scratch)
         folder.mkdir(parents=True, exist_ok=True)
         executable = build_peer(folder)
-        header = ["N", "φ", "shell r_n/σ", "C", "sim", "sim / C", "quartiles"]
+        header = ["N", "φ", "shell r_n/σ", "C, best chunk", "sim, best chunk",
+                  "sim / C, median of rounds", "quartiles"]
         if args.minimal:
-            header += ["minimal", "minimal / C", "quartiles"]
+            header += ["minimal, best chunk", "minimal / C, median of rounds", "quartiles"]
         table = [f"| {' | '.join(header)} |", f"|{' --- |' * len(header)}"]
         print("\n".join(table))
         rows = []

@@ -35,5 +35,5 @@ class InelasticCollapseError(PhysicsBreakdown):
             f"[{shown}] collide ever faster (consecutive contacts less than the collapse "
             f"interval apart). Hard disks with restitution < 1 can collide infinitely often in "
             f"finite time; switch on the TC model (tc.time, far below the mean free time; the "
-            f"seed study used 1e-8) so that contacts closer than t_c are elastic."
+            f"crater scene uses 1e-8) so that contacts closer than t_c are elastic."
         )

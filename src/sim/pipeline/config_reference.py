@@ -45,8 +45,11 @@ USAGE = (
     ("python -m sim [scenario=NAME] KEY=A,B ... -m", "a sweep, jobs in parallel"),
     ("python -m sim resume=RUN_FILE [KEY=VALUE ...]", "continue a stopped run"),
     ("python -m sim --help | --hydra-help", "this text | Hydra's help"),
+    ("sim-inspect RUN_FILE [--json]", "what a run file holds"),
 )
-OUTPUTS = ("A run writes outputs/runs/DATE/TIME/run.h5, a sweep outputs/multirun/DATE/TIME/N/. "
+OUTPUTS = ("A run writes outputs/runs/DATE/TIME/run.h5 (hydra.run.dir=DIR: DIR/run.h5), a sweep "
+           "outputs/multirun/DATE/TIME/N/ (hydra.sweep.dir=DIR); sim.analysis.open_run(RUN_FILE) "
+           "reads a run as an xarray Dataset, open_sweep(DIR) a sweep. "
            "Exit status 0 done, 1 a run file not written or jobs of a sweep failed, 2 bad input "
            "(nothing written), 3 the physics broke down, 130/143 stopped by Ctrl-C/SIGTERM "
            "(resume= continues).")

@@ -8,7 +8,7 @@
 * :func:`melted_lattice` — that lattice melted by an elastic run of its own: a random, fluid
   arrangement at packings random addition cannot reach (equal hard disks are fluid below
   φ ≈ 0.70; Bernard & Krauth, Phys. Rev. Lett. 107, 155704 (2011)).
-* :func:`fixed_speed` (equal speeds, random directions, as the seed study) and
+* :func:`fixed_speed` (equal speeds, random directions) and
   :func:`maxwellian` (components drawn from N(0, T/m)); :func:`remove_drift` zeroes the total
   momentum.
 
@@ -208,8 +208,8 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
                    collisions_per_disk=MELT_COLLISIONS_PER_DISK):
     """Positions float64[n, 2] of n disks placed on :func:`hexagonal_lattice` and melted by
     an elastic run confined to the region (Maxwellian velocities at T = 1, zero momentum,
-    ``collisions_per_disk`` × n disk–disk collisions): hard walls at the region's edges, periodic along an axis the region spans
-    in a periodic box. Deterministic in ``seed``."""
+    ``collisions_per_disk`` × n disk–disk collisions): hard walls at the region's edges,
+    periodic along an axis the region spans in a periodic box. Deterministic in ``seed``."""
     from sim.engine.core import Engine
     from sim.engine.inputs import Boundary  # the engine prepares, it does not place
 

@@ -226,8 +226,9 @@ def warn_large(cfg):
     """One line on stderr when the run file will exceed :data:`LARGE_FILE_BYTES`."""
     nbytes, key = estimate(cfg)["file"]
     if nbytes > LARGE_FILE_BYTES:
+        value = _value(cfg, key)
         print(f"sim: warning: the run file will take up to {_size(nbytes)} "
-              f"({key}={_value(cfg, key)}); fewer snapshots make it smaller",
+              f"({key}={'null' if value is None else value}); fewer snapshots make it smaller",
               file=sys.stderr)
 
 
