@@ -119,7 +119,7 @@ def hydra_main(cfg):
     print(f"{info['scene']}: {info['n']} disks, {info['collisions']} collisions to t = "
           f"{info['time_span'][1]:.6g}, {info['snapshots']} snapshots, energy "
           f"{info['final_energy']:.6g} (dissipated {info['dissipated_energy']:.3g}, balance "
-          f"error {info['energy_drift']:.1e}), stopped by {info['stop_reason']}\n"
+          f"error {info['energy_drift']:.1e}), stop reason: {info['stop_reason']}\n"
           f"run file: {path}", flush=True)
     if info["stop_reason"] in ("interrupted", "terminated"):
         if sweeping:
