@@ -2,8 +2,6 @@
 file, its schema sections, its builder, preparation, checks and disk count, and composes and
 builds; no scenario file names a scene the registry lacks."""
 
-import typing
-from dataclasses import fields, is_dataclass
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +11,8 @@ from omegaconf import OmegaConf
 
 from sim.pipeline import resources
 from sim.pipeline.cli import CONF_DIR
-from sim.pipeline.config import ConfigError, SimConfig, validate
+from sim.pipeline.config import ConfigError, validate
+from sim.pipeline.config_reference import scene_sections
 from sim.pipeline.scenes import BUILDERS, PREPARATIONS, SCENES, SceneSpec, build_scene, preparation
 from test_pipeline import compose_scene
 
@@ -21,17 +20,6 @@ SCENARIO_DIR = Path(CONF_DIR, "scenario")
 #: scenario file name → the scene it names
 SCENARIO_SCENES = {path.stem: yaml.safe_load(path.read_text())["scene"]
                    for path in sorted(SCENARIO_DIR.glob("*.yaml"))}
-
-
-def optional_sections():
-    """The schema's sections that only some scenes have: dataclass fields that default to
-    None."""
-    sections = set()
-    for f in fields(SimConfig):
-        inner = [a for a in typing.get_args(f.type) if a is not type(None)]
-        if f.default is None and len(inner) == 1 and is_dataclass(inner[0]):
-            sections.add(f.name)
-    return sections
 
 
 def test_every_scenario_file_names_a_registered_scene():
@@ -68,7 +56,7 @@ def test_a_stored_scene_outside_the_registry_counts_disks_n():
 
 def test_the_schema_sections_are_those_the_scenes_need():
     claimed = {section for scene in SCENES.values() for section in scene.sections}
-    assert claimed == optional_sections()
+    assert claimed == set(scene_sections())
 
 
 def test_an_unregistered_scene_is_refused_with_every_registered_one_named():

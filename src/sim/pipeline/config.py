@@ -11,13 +11,13 @@ checks of each scene's own keys, are :data:`sim.pipeline.scenes.SCENES`.
 
 import math
 import warnings
-from dataclasses import fields, is_dataclass
 from typing import Any
 
 from hydra.core.config_store import ConfigStore
 from omegaconf import DictConfig, OmegaConf
 
 from sim.effects import check_config
+from sim.pipeline.config_reference import leaves
 from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.input_checks import (
     LARGEST,
@@ -31,7 +31,7 @@ from sim.pipeline.input_checks import (
     within,
 )
 from sim.pipeline.scenes import SCENES
-from sim.pipeline.schema import RENAMED_KEYS, SimConfig
+from sim.pipeline.schema import RENAMED_KEYS, SimConfig, leaf_fields, plain_type
 
 
 def renamed_keys(cfg, warn=True):
@@ -57,29 +57,15 @@ def register():
     ConfigStore.instance().store(name="sim_schema", node=SimConfig)
 
 
-def integer_keys(node=SimConfig, prefix=""):
+def integer_keys():
     """Dotted keys of the schema typed int (``disks.n``, ``stop.collisions``, …)."""
-    keys = []
-    for f in fields(node):
-        kind = f.type
-        inner = [a for a in getattr(kind, "__args__", ()) if a is not type(None)]
-        if kind is int or inner == [int]:
-            keys.append(prefix + f.name)
-        elif is_dataclass(kind) or (inner and is_dataclass(inner[0])):
-            keys += integer_keys(kind if is_dataclass(kind) else inner[0], f"{prefix}{f.name}.")
-    return keys
+    return [key for key, f in leaf_fields() if plain_type(f.type) is int]
 
 
 def flat(cfg):
     """{dotted key: value} of every leaf of a config, interpolations resolved (lists stay
     whole)."""
-    def walk(node, prefix):
-        for key, value in node.items():
-            if isinstance(value, dict) and value:
-                yield from walk(value, f"{prefix}{key}.")
-            else:
-                yield f"{prefix}{key}", value
-    return dict(walk(OmegaConf.to_container(cfg, resolve=True), ""))
+    return leaves(OmegaConf.to_container(cfg, resolve=True))
 
 
 def _leaves(value):

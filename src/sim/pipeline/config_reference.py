@@ -26,13 +26,12 @@ import argparse
 import re
 import shutil
 import textwrap
-import typing
 from dataclasses import MISSING, dataclass, fields, is_dataclass
 from pathlib import Path
 
 import yaml
 
-from sim.pipeline.schema import CONF_DIR, RENAMED_KEYS, SimConfig
+from sim.pipeline.schema import CONF_DIR, RENAMED_KEYS, SimConfig, leaf_fields, plain_type
 
 CONF = Path(CONF_DIR)
 #: keys set by the scenario files, not by hand (``scenario=NAME`` chooses them)
@@ -192,33 +191,24 @@ def _prefixes(key):
 
 def _kind(annotation):
     """``float``, ``float or null``, … of a schema field's type."""
-    inner = [a for a in typing.get_args(annotation) if a is not type(None)]
-    if inner:
-        return f"{_kind(inner[0])} or null"
-    return getattr(annotation, "__name__", str(annotation))
+    plain = plain_type(annotation)
+    name = getattr(plain, "__name__", str(plain))
+    return f"{name} or null" if plain is not annotation else name
 
 
-def schema_keys(node=SimConfig, prefix=""):
+def schema_keys():
     """{dotted key: (type, default)} of every leaf of the schema, old names and the keys set
     by the scenario files aside."""
-    found = {}
-    for f in fields(node):
-        key = prefix + f.name
-        inner = [a for a in typing.get_args(f.type) if a is not type(None)]
-        section = f.type if is_dataclass(f.type) else inner[0] if inner else None
-        if is_dataclass(section):
-            found.update(schema_keys(section, f"{key}."))
-        elif key not in RENAMED_KEYS and key not in SET_BY_SCENARIO:
-            default = f.default_factory() if f.default is MISSING else f.default
-            found[key] = (_kind(f.type), default)
-    return found
+    return {key: (_kind(f.type), f.default_factory() if f.default is MISSING else f.default)
+            for key, f in leaf_fields()
+            if key not in RENAMED_KEYS and key not in SET_BY_SCENARIO}
 
 
 def scene_sections():
     """The schema's sections that only some scenes have (fields of SimConfig defaulting to
     None)."""
     return tuple(f.name for f in fields(SimConfig)
-                 if f.default is None and any(is_dataclass(a) for a in typing.get_args(f.type)))
+                 if f.default is None and is_dataclass(plain_type(f.type)))
 
 
 def value(x):

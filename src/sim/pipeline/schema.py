@@ -6,7 +6,8 @@ engine) so that the reference of the keys (:mod:`sim.pipeline.config_reference`,
 sim --help``) reads it without loading the compiled engine.
 """
 
-from dataclasses import dataclass, field
+import typing
+from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Optional
 
@@ -179,3 +180,20 @@ class SimConfig:
 #: Keys renamed in this release: old name → new name. The old name still works, with a
 #: FutureWarning, until the next release.
 RENAMED_KEYS = {"stop.events": "stop.contacts"}
+
+
+def plain_type(annotation):
+    """The type a field holds when it holds a value: ``float`` of ``Optional[float]``."""
+    inner = [a for a in typing.get_args(annotation) if a is not type(None)]
+    return inner[0] if inner else annotation
+
+
+def leaf_fields(node=SimConfig, prefix=""):
+    """(dotted key, dataclass field) of every leaf of the schema, sections (also optional
+    ones, such as ``projectile``) walked into."""
+    for f in fields(node):
+        section = plain_type(f.type)
+        if is_dataclass(section):
+            yield from leaf_fields(section, f"{prefix}{f.name}.")
+        else:
+            yield prefix + f.name, f
