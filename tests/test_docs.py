@@ -103,14 +103,13 @@ def test_every_make_target_the_docs_name_exists():
     assert not missing, "\n".join(missing)
 
 
-def python_examples():
-    """(page, code) of every Python block of the README and the getting-started page."""
-    return [(name, code) for name in ("README.md", "docs/getting-started.md")
-            for code in re.findall(r"```python\n(.*?)```", (ROOT / name).read_text(), re.S)]
+#: (page, code) of every Python block of the README and the getting-started page
+PYTHON_EXAMPLES = [(name, code) for name in ("README.md", "docs/getting-started.md")
+                   for code in re.findall(r"```python\n(.*?)```", (ROOT / name).read_text(), re.S)]
 
 
-@pytest.mark.parametrize("page, code", python_examples(),
-                         ids=[f"{name}-{k}" for k, (name, _) in enumerate(python_examples())])
+@pytest.mark.parametrize("page, code", PYTHON_EXAMPLES,
+                         ids=[f"{name}-{k}" for k, (name, _) in enumerate(PYTHON_EXAMPLES)])
 def test_the_python_examples_run(page, code, tmp_path):
     """Each example runs as printed; a run file it opens (``outputs/runs/DATE/TIME/run.h5``)
     is one the test makes, and its wall budget is widened so that a loaded machine cannot
