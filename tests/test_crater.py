@@ -73,17 +73,20 @@ def test_empty_and_full_beds():
 
 def test_a_crater_at_twice_the_speed_is_the_same_crater_in_half_the_time():
     """Hard disks have no energy scale (figure 10): doubling every velocity and halving t_c
-    gives the same collisions at half the times — to the bit, as ×2 is exact in float64."""
+    gives the same collisions at half the times — to the bit, as ×2 is exact in float64. The
+    crater scene's effects: ξ, ξ_w, t_c; bed and projectile of their own species."""
     bed = hexagonal_lattice(300, 0.012, region=((0, 1), (0, 0.5)), seed=3)
     n = len(bed)
     position = np.vstack([bed, [[0.5, 0.75]]])
     radius = np.append(np.full(n, 0.012), 0.05)
     mass = np.append(np.ones(n), (0.05 / 0.012) ** 2)
+    species = np.append(np.zeros(n, dtype=int), 1)
     runs = []
     for speed in (5.0, 10.0):
         velocity = np.zeros((n + 1, 2))
         velocity[-1] = [0.0, -speed]
-        engine = Engine(position, velocity, radius, mass, restitution=0.5, tc=5e-8 / speed)
+        engine = Engine(position, velocity, radius, mass, species, restitution=0.5,
+                        wall_restitution=0.5, tc=5e-8 / speed)
         engine.run(collisions=20_000)
         runs.append(engine)
     slow, fast = runs

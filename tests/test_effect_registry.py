@@ -19,7 +19,8 @@ from sim.checks.validation import STUDIES
 from sim.effects import EFFECTS, Effects, engine_keywords
 from sim.engine import Engine
 from sim.pipeline.config import flat
-from test_pipeline import CONF_DIR, compose_scene
+from sim.pipeline.overrides import CONF_DIR
+from variants import compose_scene
 
 EFFECT_MODULES = sorted(p.stem for p in Path(sim.effects.__file__).parent.glob("*.py")
                         if p.stem not in ("__init__", "rules"))

@@ -208,13 +208,13 @@ def test_scenes_float64_cannot_hold_are_refused_naming_the_parameter(scene, matc
 
 
 # -- 3. the stall guard -----------------------------------------------------------------------
-def touching_ring(n=20, radius=0.01, **options):
+def touching_ring(n=20, radius=0.01, periodic_y=True, **options):
     """n disks touching all round a periodic box 2 n R wide; the first moves along the row."""
     x = radius + 2.0 * radius * np.arange(n)
     velocity = np.zeros((n, 2))
     velocity[0, 0] = 1.0
     return Engine(np.stack([x, np.full(n, 0.5)], axis=1), velocity, radius,
-                  boundary=Boundary(size=(2 * n * radius, 1.0), periodic=(True, True)),
+                  boundary=Boundary(size=(2 * n * radius, 1.0), periodic=(True, periodic_y)),
                   **options)
 
 
@@ -231,24 +231,40 @@ def test_a_chain_creeping_round_a_periodic_box_is_a_stall(options, chunk_events)
     assert engine.time < 1e-12
 
 
+#: a thermal top wall that disks moving along a row at y = 0.5 never reach: with it,
+#: inelastic disks without the TC model run the compiled loop of the driven scene
+#: (tests/variants.py), and nothing else changes
+UNREACHED_THERMAL_WALL = {"top": {"temperature": 1.0}}
+
+
 def test_an_inelastic_chain_without_tc_collapses():
+    """The ring of the test above, inelastic and without the TC model, with walls along y
+    that it never reaches (every contact normal along x): collapse, not a stall."""
+    engine = touching_ring(restitution=0.5, periodic_y=False, walls=UNREACHED_THERMAL_WALL)
     with pytest.raises(InelasticCollapseError, match="TC model"):
-        touching_ring(restitution=0.5).run(contacts=10**7)
+        engine.run(contacts=10**7)
+    assert engine.wall_contacts == 0
 
 
 def test_stall_interval_follows_the_fastest_speed_the_scene_sets():
     """stall_dt = 2⁻⁴⁴ D / v: D the far edge of the disks (1 here), v the initial rms speed,
-    √(|g| L), |U| + A ω or √(T_w/m), whichever is fastest."""
+    √(|g| L), |U| + A ω or √(T_w/m), whichever is fastest. Restitution and t_c set no speed;
+    each scene carries those of the shipped scene with its effect (the settling crater bed,
+    the vibrated bed, the driven gas), whose compiled loops the quick tests share."""
     def stall_dt(velocity=(0.3, 0.4), **options):
         return Engine([[0.95, 0.5]], [velocity], 0.05, **options).stall_dt
 
+    inelastic = {"restitution": 0.9, "wall_restitution": 0.9, "tc": 1e-4}
     assert stall_dt() == 2.0**-44 / 0.5
     assert stall_dt(velocity=(0.0, 0.0)) == 2.0**-44
-    assert stall_dt(gravity=[0.0, -4.0]) == 2.0**-44 / 2.0
-    assert stall_dt(walls={"top": {"speed": -3.0}}) == 2.0**-44 / 3.0
-    assert stall_dt(walls={"top": {"amplitude": 0.01, "frequency": 500.0}}) == pytest.approx(
-        2.0**-44 / 5.0, rel=1e-15)
-    assert stall_dt(walls={"top": {"temperature": 16.0}}) == 2.0**-44 / 4.0
+    assert stall_dt(gravity=[0.0, -4.0], **inelastic) == 2.0**-44 / 2.0
+    # a moving wall faster than √(|g| L) = 1
+    assert stall_dt(walls={"top": {"speed": -3.0}}, gravity=[0.0, -1.0],
+                    **inelastic) == 2.0**-44 / 3.0
+    assert stall_dt(walls={"top": {"amplitude": 0.01, "frequency": 500.0}},
+                    gravity=[0.0, -1.0], **inelastic) == pytest.approx(2.0**-44 / 5.0,
+                                                                        rel=1e-15)
+    assert stall_dt(walls={"top": {"temperature": 16.0}}, restitution=0.9) == 2.0**-44 / 4.0
     # disks in a corner of a huge box: the ulps of their coordinates, not of the box side
     assert stall_dt(boundary=Boundary(size=(1e30, 1e30))) == 2.0**-44 / 0.5
 
@@ -263,10 +279,13 @@ def test_errors_of_physics_share_a_base_and_name_their_stop_reason():
     position = np.array([[0.4, 0.5], [0.5, 0.5], [0.6, 0.5]])
     velocity = [[1.0, 0.0], [0.0, 0.0], [-0.7, 0.0]]
     with pytest.raises(PhysicsBreakdown) as caught:
-        Engine(position, velocity, 0.01, restitution=0.05).run(collisions=10**6)
+        Engine(position, velocity, 0.01, restitution=0.05,
+               walls=UNREACHED_THERMAL_WALL).run(collisions=10**6)
     assert caught.value.stop_reason == "inelastic_collapse"
     assert "\n" not in str(caught.value) and "tc.time" in str(caught.value)
-    lone = Engine([[0.5, 0.5]], [[0.0, 0.0]], 0.05, walls={"right": {"speed": -0.1}})
+    # a piston in the vibrated bed's effects (ξ, ξ_w, t_c, gravity: its compiled loop)
+    lone = Engine([[0.5, 0.5]], [[0.0, 0.0]], 0.05, walls={"right": {"speed": -0.1}},
+                  gravity=[0.0, -1.0], restitution=0.9, wall_restitution=0.9, tc=1e-4)
     with pytest.raises(PhysicsBreakdown) as caught:
         lone.run(time=10.0)
     assert caught.value.stop_reason == "closed_box"
@@ -276,11 +295,14 @@ def test_errors_of_physics_share_a_base_and_name_their_stop_reason():
 # -- 5. the piston guard runs after every chunk -----------------------------------------------
 def test_a_jammed_piston_is_caught_when_the_caller_stops_every_few_collisions():
     """Snapshots every 200 collisions end every call before its chunk: the guard still runs
-    after each, and the jam is reported before the walls close."""
+    after each, and the jam is reported before the walls close. The gas has the vibrated
+    bed's effects (ξ, ξ_w, t_c, gravity: its compiled loop); as the piston squeezes it, its
+    contacts come within t_c of each other, turn elastic, and the energy diverges."""
     n = 50
     radius = radius_for_packing(n, 0.05)
     engine = Engine(random_sequential(np.full(n, radius), seed=1), fixed_speed(n, 1.0, seed=2),
-                    radius, walls={"right": {"speed": -0.2}})
+                    radius, walls={"right": {"speed": -0.2}}, gravity=[0.0, -1.0],
+                    restitution=0.9, wall_restitution=0.9, tc=1e-4)
     with pytest.raises(ClosedBoxError, match="jammed"):
         for _ in range(100_000):
             engine.run(collisions=engine.collisions + 200)
@@ -319,8 +341,8 @@ def test_a_checkpoint_of_another_scene_is_refused_before_anything_changes():
     larger = gas(120, 0.3, seed=1)
     with pytest.raises(ValueError, match="disks/table has shape"):
         engine.load_state_dict(larger.state_dict())
-    logging = gas(100, 0.3, seed=1, pressure_tensor=True)
-    with pytest.raises(ValueError, match="unknown \\['virial_tensor'\\]"):
-        engine.load_state_dict(logging.state_dict())
+    recording = gas(100, 0.3, seed=1, unwrap=True, pressure_tensor=True, event_log=1000)
+    with pytest.raises(ValueError, match=r"unknown \['disks/images', 'virial_tensor'\]"):
+        engine.load_state_dict(recording.state_dict())
     for key, value in engine.state_dict().items():
         np.testing.assert_array_equal(value, before[key], err_msg=key)

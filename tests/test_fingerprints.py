@@ -18,7 +18,7 @@ import pytest
 from conftest import assert_no_overlap, gas
 from sim.engine import Boundary, Engine
 from sim.pipeline.runner import build_engine
-from test_pipeline import SCENARIOS, compose_scene
+from variants import SCENARIOS, compose_scene
 
 FINGERPRINTS = Path(__file__).with_name("fingerprints.json")
 RECORD = os.environ.get("SIM_RECORD_FINGERPRINTS") == "1"
@@ -122,7 +122,15 @@ def _check(name, engine):
     assert value == expected, f"{name}: the final state changed"
 
 
-@pytest.mark.parametrize("name", sorted(ENGINE_SCENES))
+#: engine scenes whose compiled loop is none of the quick suite's (tests/variants.py): their
+#: bits are checked by ``make validate``
+SLOW_SCENES = {"gravity_periodic_x", "mixture_walls_inelastic", "moving_thermal_walls",
+               "projectile"}
+
+
+@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow)
+                                  if name in SLOW_SCENES else name
+                                  for name in sorted(ENGINE_SCENES)])
 def test_engine_scene_keeps_its_bits(name):
     make, stop = ENGINE_SCENES[name]
     engine = make()

@@ -16,7 +16,9 @@ G = 9.81
 def test_free_flight_is_a_parabola():
     """A disk thrown across the box: r(t) = r0 + v0 t + g t²/2 and v(t) = v0 + g t."""
     r0, v0, g = np.array([0.1, 0.2]), np.array([0.3, 2.0]), np.array([0.0, -G])
-    engine = Engine([r0], [v0], 0.01, gravity=g)
+    # no contact: restitution and TC model on only to share the settling bed's compiled variant
+    engine = Engine([r0], [v0], 0.01, gravity=g, restitution=0.9, wall_restitution=0.9,
+                    tc=1e-4)
     for t in np.linspace(0.0, 0.38, 20):
         np.testing.assert_allclose(engine.positions(t)[0], r0 + v0 * t + 0.5 * g * t * t,
                                    rtol=0, atol=1e-15)
@@ -29,8 +31,10 @@ def test_dropped_ball_bounces_to_the_exact_heights():
     bounce leaves at v_k = ξ_w^k √(2 g h0), reaches h_k = ξ_w^(2k) h0, and lands at
     t_k = √(2h0/g) (1 + 2 Σ_{i=1}^{k-1} ξ_w^i) (Luding et al., Phys. Rev. E 50, 4113 (1994))."""
     radius, h0, xi = 0.05, 0.5, 0.8
+    # one ball: no disk contact for ξ; t_c far below the shortest flight here (1e-3), so every
+    # bounce dissipates (the settling bed's compiled variant)
     engine = Engine([[0.5, radius + h0]], [[0.0, 0.0]], radius, wall_restitution=xi,
-                    gravity=[0.0, -G])
+                    gravity=[0.0, -G], restitution=xi, tc=1e-6)
     fall = math.sqrt(2.0 * h0 / G)
     landing = fall
     for k in range(1, 31):
@@ -44,6 +48,7 @@ def test_dropped_ball_bounces_to_the_exact_heights():
     assert engine.dissipated_energy == pytest.approx(G * h0 * (1.0 - xi**60), rel=1e-12)
 
 
+@pytest.mark.slow  # needs restitution without the TC model under gravity: no quick variant
 def test_bouncing_ball_without_tc_is_reported_as_collapse():
     """The bounces of an inelastic ball accumulate at t∞ = √(2h0/g)(1 + ξ)/(1 − ξ): without the
     TC model the run ends there with an error that names the disk."""
@@ -61,8 +66,9 @@ def test_bouncing_ball_with_tc_keeps_bouncing_without_collapse():
     dissipative bounce shortens the interval from at least t_c to at least ξ_w t_c, and the
     ball bounces at that interval for as long as asked."""
     tc = 1e-4
+    # one ball: no disk contact for ξ (the settling bed's compiled variant)
     engine = Engine([[0.5, 0.3]], [[0.0, 0.0]], 0.05, wall_restitution=0.8,
-                    gravity=[0.0, -G], tc=tc)
+                    gravity=[0.0, -G], tc=tc, restitution=0.8)
     engine.run(time=5.0)
     assert engine.time > 4.99
     interval = 2.0 * engine.velocities()[0, 1] / G
@@ -70,6 +76,7 @@ def test_bouncing_ball_with_tc_keeps_bouncing_without_collapse():
     assert engine.positions()[0, 1] >= 0.05
 
 
+@pytest.mark.slow  # elastic disks under gravity: no quick variant
 @pytest.mark.parametrize("periodic_x", [False, True])
 def test_elastic_gas_under_gravity_conserves_mechanical_energy(periodic_x):
     n = 1000
@@ -105,22 +112,33 @@ def test_gravity_along_a_periodic_axis_is_refused():
                boundary=Boundary(periodic=(True, True)))
 
 
-def test_disks_placed_at_rest_on_the_floor():
-    """A lattice whose bottom row touches the floor at rest: under the TC model those disks
-    leave with the bounce that lasts t_c and the bed runs, energy booked as the floor's work;
-    without it the floor would hold them through infinitely many contacts at one instant,
-    and the run stops with a clear error."""
+def bed_at_rest_on_the_floor():
+    """200 disks on a lattice whose bottom row touches the floor, at rest."""
     n, radius = 200, 0.01
     position = hexagonal_lattice(n, radius, region=((0.0, 1.0), (0.0, 0.2)), seed=1)
     assert np.isclose(position[:, 1].min(), radius, rtol=0, atol=1e-15)
-    engine = Engine(position, np.zeros((n, 2)), radius, gravity=[0.0, -1.0], restitution=0.8,
-                    wall_restitution=0.8, tc=1e-3)
+    return position, radius
+
+
+def test_disks_placed_at_rest_on_the_floor_leave_it_under_the_tc_model():
+    """Under the TC model the disks of the bottom row leave with the bounce that lasts t_c and
+    the bed runs, energy booked as the floor's work."""
+    position, radius = bed_at_rest_on_the_floor()
+    engine = Engine(position, np.zeros_like(position), radius, gravity=[0.0, -1.0],
+                    restitution=0.8, wall_restitution=0.8, tc=1e-3)
     energy = engine.potential_energy()
     engine.run(time=1.0)
     assert_no_overlap(engine)
     balance = (engine.kinetic_energy() + engine.potential_energy() + engine.dissipated_energy
                - engine.wall_work - energy)
     assert abs(balance) <= 1e-12 * engine.dissipated_energy
-    elastic = Engine(position, np.zeros((n, 2)), radius, gravity=[0.0, -1.0])
+
+
+@pytest.mark.slow  # elastic disks under gravity: no quick variant
+def test_disks_placed_at_rest_on_the_floor_without_the_tc_model_stop_the_run():
+    """Without the TC model the floor would hold the bottom row through infinitely many
+    contacts at one instant: the run stops with a clear error."""
+    position, radius = bed_at_rest_on_the_floor()
+    elastic = Engine(position, np.zeros_like(position), radius, gravity=[0.0, -1.0])
     with pytest.raises(StalledError, match="resting on a wall under gravity"):
         elastic.run(time=1.0)

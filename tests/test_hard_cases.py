@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
-from conftest import assert_no_overlap, gas
+from conftest import assert_no_overlap, engine_examples, gas
 from sim.checks.audit import overlapping_pairs
 from sim.engine import Boundary, Engine, InelasticCollapseError
 from sim.pipeline.initial import (
@@ -42,15 +42,20 @@ def test_dense_solid_and_coexistence(phi):
 
 
 def test_mass_ratios_of_a_million_both_ways_in_one_box():
+    """One disk 10⁶ times heavier than the rest and one 10⁶ times lighter, each its own
+    species (a mixture, as the mixture scene has)."""
     n, phi = 500, 0.3
     radius = radius_for_packing(n, phi)
     position = random_sequential(np.full(n, radius), seed=53)
     mass = np.ones(n)
     mass[0], mass[1] = 1e6, 1e-6
-    engine = Engine(position, fixed_speed(n, 1.0, seed=54), radius, mass)
+    species = np.zeros(n, dtype=int)
+    species[0], species[1] = 1, 2
+    engine = Engine(position, fixed_speed(n, 1.0, seed=54), radius, mass, species)
     runs_clean(engine)
 
 
+@pytest.mark.slow  # an elastic gas with one big disk: no quick variant (tests/variants.py)
 def test_one_disk_fifty_times_larger_than_the_rest():
     n, small = 2000, 0.004
     big_radius = 50 * small
@@ -119,6 +124,7 @@ def test_grazing_collisions_keep_disks_apart():
         assert_no_overlap(engine)
 
 
+@pytest.mark.slow  # ξ_w < 1 without gravity, with and without TC: no quick variant
 def test_dense_inelastic_gas_collapses_without_tc_and_finishes_with_it():
     """ξ = 0.5 at φ = 0.6 in a box with walls: without the TC model clusters collapse and the
     run ends with the collapse error; with it the same gas runs to its energy stop."""
@@ -149,7 +155,7 @@ def test_a_hundred_million_collisions_of_a_thousand_disks():
     assert_no_overlap(engine)
 
 
-@settings(max_examples=25, deadline=None)
+@engine_examples(25)
 @given(n=st.integers(10, 60), phi=st.floats(0.05, 0.6), seed=st.integers(0, 10_000),
        periodic=st.booleans(), restitution=st.sampled_from([None, 1.0]))
 def test_random_small_systems(n, phi, seed, periodic, restitution):

@@ -5,23 +5,26 @@ new module."""
 import importlib
 import subprocess
 import sys
-
-import pytest
+import warnings
 
 from sim.moved import MOVED
 
 
-@pytest.mark.parametrize("old", sorted(MOVED))
-def test_old_path_gives_the_module_with_a_warning(old):
-    sys.modules.pop(old, None)
-    with pytest.warns(DeprecationWarning, match=MOVED[old]):
-        module = importlib.import_module(old)
-    assert module is importlib.import_module(MOVED[old])
+def test_every_old_path_gives_the_module_with_a_warning():
+    wrong = []
+    for old, new in sorted(MOVED.items()):
+        sys.modules.pop(old, None)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            module = importlib.import_module(old)
+        warned = [w for w in caught if issubclass(w.category, DeprecationWarning)
+                  and new in str(w.message)]
+        if module is not importlib.import_module(new) or not warned:
+            wrong.append(old)
+    assert not wrong, f"old paths that do not lead to their module with a warning: {wrong}"
 
 
-@pytest.mark.parametrize("old, command", [("sim.inspect", "sim-inspect"),
-                                          ("sim.movie", "sim-movie")])
-def test_old_command_path_runs(old, command):
-    out = subprocess.run([sys.executable, "-m", old, "--help"], capture_output=True, text=True,
-                         check=True)
-    assert out.stdout.startswith(f"usage: {command}")
+def test_an_old_command_path_runs():
+    out = subprocess.run([sys.executable, "-m", "sim.inspect", "--help"], capture_output=True,
+                         text=True, check=True)
+    assert out.stdout.startswith("usage: sim-inspect")

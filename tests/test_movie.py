@@ -24,7 +24,9 @@ from sim.pipeline.runner import run
 #: the two disks of the two_disks scene, their snapshots 0.01 apart
 TWO_DISKS = ["scenario=two_disks", "stop.time=2", "output.every_time=0.01",
              "output.progress=false"]
-SCENES = {"walls_and_gravity": [*TWO_DISKS, "gravity=[0,-1]"],
+#: with gravity, inelastic with the TC model: the settling bed's compiled variant (variants.py)
+SCENES = {"walls_and_gravity": [*TWO_DISKS, "gravity=[0,-1]", "restitution.disk=0.9",
+                                "restitution.wall=0.9", "tc.time=1e-6"],
           "periodic": [*TWO_DISKS, "box.boundary=periodic", "observe.clusters.gap=3"]}
 
 

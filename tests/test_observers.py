@@ -79,9 +79,16 @@ def test_local_fields_add_up_to_the_whole_gas(tmp_path):
     assert pooled == pytest.approx(heat / np.sum(counts[counts > 1] - 1.0), rel=1e-12)
 
 
+#: every recorder of the event loop on (unwrapped positions, pressure tensor, event log): the
+#: compiled loop the quick tests of any of them share (tests/variants.py)
+RECORDERS = ("observe.mean_squared_displacement=true", "observe.pressure_tensor=true",
+             "observe.event_log=true")
+
+
 def periodic_gas(tmp_path, *overrides):
+    """A periodic gas at φ = 0.3, T = 1, with every recorder on."""
     cfg = compose_config(["box.boundary=periodic", "disks.packing_fraction=0.3",
-                          "disks.temperature=1.0", "disks.speed=null", *overrides,
+                          "disks.temperature=1.0", "disks.speed=null", *RECORDERS, *overrides,
                           "output.progress=false"])
     return open_run(run(cfg, tmp_path))
 
@@ -96,8 +103,10 @@ def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
     radius = radius_for_packing(n, 0.2)
     position = random_sequential(np.full(n, radius), periodic=(True, True), seed=4)
     velocity = np.random.default_rng(5).normal(size=(n, 2)) * 10.0
+    # every recorder on: the unwrapped positions are the test's, the others share the loop
+    recorders = {"unwrap": True, "pressure_tensor": True, "event_log": 1000}
     engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
-                    unwrap=True)
+                    **recorders)
     unwrapped = engine.positions(0.0)
     previous = unwrapped.copy()
     for t in np.arange(1, 400) * 2e-3:  # at most 0.02 × 10 × a few σ < L/2 per step
@@ -109,7 +118,7 @@ def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
     assert np.abs(unwrapped - position).max() > 2.0  # disks crossed the box several times
 
     lone = Engine([[0.5, 0.5]], [[3.0, -4.0]], 0.01, boundary=Boundary(periodic=(True, True)),
-                  unwrap=True)
+                  **recorders)
     lone.run(time=10.0)
     np.testing.assert_allclose(lone.unwrapped_positions(10.0), [[30.5, -39.5]], rtol=1e-14)
 
@@ -165,11 +174,17 @@ def test_pressure_tensor_is_isotropic_and_its_trace_is_the_pressure(tmp_path):
     assert abs(pressure[0, 1]) < 0.03 * pressure[0, 0]
 
 
-def test_event_log_holds_every_contact(tmp_path):
+@pytest.mark.parametrize("effects", [
+    # every recorder on (the quick suite's compiled loop): nothing is dissipated
+    pytest.param(RECORDERS, id="elastic"),
+    # inelastic disks and walls with the log alone: a loop of its own
+    pytest.param(("restitution.disk=0.8", "restitution.wall=0.9", "tc.time=1e-7",
+                  "observe.event_log=true"), id="inelastic", marks=pytest.mark.slow),
+])
+def test_event_log_holds_every_contact(effects, tmp_path):
     """The log has one row per contact, in order; its dissipated energies add up to the
     run's, and for equal disks Σ |Δp| σ over disk contacts is the collision virial."""
-    cfg = compose_config(["disks.n=500", "restitution.disk=0.8", "restitution.wall=0.9",
-                          "tc.time=1e-7", "observe.event_log=true", "stop.collisions=100000",
+    cfg = compose_config(["disks.n=500", *effects, "stop.collisions=100000",
                           "output.every_collisions=10000", "output.progress=false"])
     path = run(cfg, tmp_path)
     log = contacts(path)
@@ -198,8 +213,9 @@ def test_event_log_streams_to_the_file_between_snapshots(tmp_path):
 
     n = 300
     radius = radius_for_packing(n, 0.2)
+    # with the other recorders on: the compiled loop of the quick tests of any of them
     engine = Engine(random_sequential(np.full(n, radius), seed=1), fixed_speed(n, 1.0, seed=2),
-                    radius, event_log=1000)
+                    radius, event_log=1000, unwrap=True, pressure_tensor=True)
     writer = RunWriter(tmp_path / "run.h5", engine, {"config": "scene: gas\n", "seed": 0},
                        buffer_bytes=48 * 2000)
     writer.snapshot(engine, 0.0)

@@ -14,7 +14,7 @@ from sim.pipeline.cli import CONF_DIR
 from sim.pipeline.config import ConfigError, validate
 from sim.pipeline.config_reference import scene_sections
 from sim.pipeline.scenes import BUILDERS, PREPARATIONS, SCENES, SceneSpec, build_scene, preparation
-from test_pipeline import compose_scene
+from variants import compose_scene
 
 SCENARIO_DIR = Path(CONF_DIR, "scenario")
 #: scenario file name → the scene it names

@@ -21,6 +21,7 @@ def dilute_gas(n=200, phi=0.05, seed=1, **options):
     return Engine(position, fixed_speed(n, 1.0, seed=seed + 1), radius, **options)
 
 
+@pytest.mark.slow  # an elastic gas between thermal walls: no quick variant
 def test_thermal_walls_bring_an_elastic_gas_to_their_temperature():
     """Elastic disks between walls at T_w reach equilibrium at T_w: energies m v²/2 are
     exponential with mean T_w (docs/physics.md, "Maxwell–Boltzmann in two dimensions")."""
@@ -75,6 +76,7 @@ def test_thermal_draws_are_reproducible_and_survive_a_restart():
     assert first.wall_work == restarted.wall_work
 
 
+@pytest.mark.slow  # an elastic gas and a piston: no quick variant
 def test_slow_piston_compresses_a_dilute_gas_adiabatically():
     """Quasi-static adiabatic compression: N dT = −P dA with P = N T Z/A gives
     d ln T = −Z d ln A; with the low-density Z = 1 + 2φ (docs/physics.md, the second virial
@@ -96,6 +98,7 @@ def test_slow_piston_compresses_a_dilute_gas_adiabatically():
     assert_no_overlap(engine)
 
 
+@pytest.mark.slow  # an elastic gas and a piston: no quick variant
 def test_piston_that_jams_the_disks_stops_the_run_with_an_error():
     """Driven at constant speed, a piston packs the disks until their collision rate and
     energy diverge (here near φ = 0.76, before the walls meet): a clear error, no hang."""
@@ -107,6 +110,7 @@ def test_piston_that_jams_the_disks_stops_the_run_with_an_error():
     assert 0.6 < packing < 0.8
 
 
+@pytest.mark.slow  # an elastic disk and a piston: no quick variant
 def test_a_lone_disk_squeezed_by_a_piston_is_stopped_before_the_walls_meet():
     """One disk between a wall and a piston: v L is an adiabatic invariant, so its energy
     diverges as the gap closes on its diameter at t = 9."""
@@ -124,11 +128,12 @@ def floor_gap(engine, t):
 
 
 def ball_on_vibrating_floor(tc):
-    """A ball (ξ_w = 0.7) dropped on a floor moving as A sin(ω t) under gravity, Γ = A ω²/g = 3."""
+    """A ball (ξ_w = 0.7) dropped on a floor moving as A sin(ω t) under gravity, Γ = A ω²/g = 3.
+    Its ξ acts on no contact of a lone ball (on for the vibrated bed's compiled variant)."""
     g, amplitude, omega = 1.0, 0.01, math.sqrt(3.0 / 0.01)
     return Engine([[0.5, 0.06]], [[0.0, 0.0]], 0.05, gravity=[0.0, -g], tc=tc,
-                  wall_restitution=0.7, walls={"bottom": {"amplitude": amplitude,
-                                                          "frequency": omega}})
+                  restitution=0.7, wall_restitution=0.7,
+                  walls={"bottom": {"amplitude": amplitude, "frequency": omega}})
 
 
 def test_ball_on_a_vibrating_floor_meets_it_exactly_and_never_sinks_into_it():
@@ -157,6 +162,7 @@ def test_ball_on_a_vibrating_floor_meets_it_exactly_and_never_sinks_into_it():
     assert abs(balance) <= 1e-13 * engine.wall_work
 
 
+@pytest.mark.slow  # restitution without the TC model on a vibrating floor: no quick variant
 def test_ball_on_a_vibrating_floor_without_tc_locks_on_and_is_reported():
     """Without the TC model the ball comes to rest on the floor through ever faster bounces
     while the floor pushes it up: inelastic collapse, reported instead of hanging."""

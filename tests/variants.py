@@ -1,0 +1,165 @@
+"""The compiled variants of the event loop that the quick suite may use, compiled once per run.
+
+numba compiles :func:`sim.engine.loop.run_events` anew for every combination of argument
+types: every effect on or off (:class:`sim.effects.Effects`), mass, species and shell radius
+shared or per disk, list capacities shared or per disk. Each combination costs about 20 s of
+compilation and almost nothing to run, so the quick suite keeps to a canonical set:
+:data:`CANONICAL`, the variants that the shipped scenes compile, and one with every observer
+on. Before the tests start, ``conftest.py`` compiles them into the numba cache in as many
+processes as there are workers (``python tests/variants.py NAME ...``), and every quick test
+fails that compiles a variant outside the set, naming it (:func:`describe`).
+
+Budget: a new effect or interaction adds at most one canonical variant (its scene); a test
+that needs another combination is ``slow``.
+
+The canonical variants in :class:`sim.engine.Engine` terms (the box's walls or periodic
+sides, N, the values of the effects and of the disks do not change the variant; every disk
+alike means one mass, one species and one radius):
+
+==============  ================================================================================
+gas             no effect, every disk alike
+mixture         no effect, masses and species per disk (radii may differ too)
+cooling         ``restitution`` < 1 and ``tc`` > 0; every disk alike
+driven          ``restitution`` < 1 and a thermal wall (``walls={...: {"temperature": T}}``)
+vibrated_bed    ``restitution``, ``wall_restitution`` < 1, ``tc``, ``gravity`` and a moving or
+                vibrating wall
+crater          ``restitution``, ``wall_restitution``, ``tc``; masses and species per disk and
+                one disk far larger than the rest (list capacities per disk)
+crater_gravity  as crater with ``gravity``; and without the large disk, every disk alike
+rough_cooling   ``restitution``, ``tangential_restitution`` (rough, no friction) and ``tc``
+observers       ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk alike
+==============  ================================================================================
+"""
+
+import contextlib
+import fcntl
+import json
+import sys
+from pathlib import Path
+
+from hydra import compose, initialize_config_dir
+
+from sim.pipeline.config import register
+from sim.pipeline.overrides import CONF_DIR
+
+register()
+SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
+
+#: overrides that make a scene small enough for a quick test (same compiled variant)
+SHRINK = {"gas": ["disks.n=300"], "mixture": ["disks.n=300"], "cooling": ["disks.n=300"],
+          "driven": ["disks.n=300"], "vibrated_bed": ["bed.n=100"],
+          "crater": ["bed.n=400", "projectile.radius=0.02"],
+          "crater_gravity": ["bed.n=300", "bed.radius=0.012", "bed.settle_time=0.5"]}
+
+#: the recorders of the loop (unwrapped positions, pressure tensor, event log) on a periodic gas
+OBSERVERS = ("box.boundary=periodic", "observe.mean_squared_displacement=true",
+             "observe.pressure_tensor=true", "observe.event_log=true")
+
+#: name → (scene, overrides) of the variants the quick suite compiles: the shipped scenes
+#: (single_disk, two_disks and scattering compile one of these; the tests that run every
+#: scene check it) and a gas with every recorder on
+CANONICAL = {**{scene: (scene,) for scene in ("gas", "mixture", "cooling", "driven",
+                                               "vibrated_bed", "crater", "crater_gravity",
+                                               "rough_cooling")},
+             "observers": ("gas", *OBSERVERS)}
+#: compiled variants of a canonical entry when more than one: crater_gravity settles its bed
+#: before it adds the projectile
+VARIANTS = {"crater_gravity": 2}
+
+
+def compose_scene(name, *overrides):
+    """The config of the shipped scene ``name``, made small (:data:`SHRINK`), with
+    ``overrides``; the progress bar off."""
+    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+        return compose("config", overrides=[f"scenario={name}", *SHRINK.get(name, []),
+                                            "output.progress=false", *overrides])
+
+
+def compiled():
+    """The signatures of ``run_events`` this process has compiled or loaded, as text."""
+    loop = sys.modules.get("sim.engine.loop")
+    return set() if loop is None else {str(s) for s in loop.run_events.signatures}
+
+
+def cached():
+    """The signatures of ``run_events`` in the numba cache (text): what every process of the
+    session compiled, subprocesses of ``python -m sim`` included. (numba keeps them in one
+    index per function, keyed by (signature, target, code hash).)"""
+    from sim.engine.loop import run_events
+
+    return {str(key[0]) for key in run_events._cache._cache_file._load_index()}
+
+
+def describe(signature):
+    """A signature of ``run_events`` (its types, or their text) in words: the effects on,
+    and what is per disk."""
+    from numba import types
+
+    if isinstance(signature, str):
+        from sim.engine.loop import run_events
+
+        signature = next(key[0] for key in run_events._cache._cache_file._load_index()
+                         if str(key[0]) == signature)
+
+    def named(group):
+        return dict(zip(group.fields, group.types, strict=True))
+
+    disks, neighbours, effects = (named(signature[k]) for k in (0, 2, 4))
+    per_disk = [name for name in ("delta", "mass", "species")
+                if isinstance(disks[name], types.Array)]
+    if isinstance(neighbours["nb_cap"], types.Array):
+        per_disk.append("list capacity")
+    on = [name for name, kind in effects.items() if kind != types.none and name != "seed"]
+    return (f"effects: {', '.join(on) or 'none'}; per disk: {', '.join(per_disk) or 'none'}; "
+            f"types: {signature}")
+
+
+@contextlib.contextmanager
+def cache_index_lock():
+    """numba's cache index of a function is one file that every process compiling it reads,
+    extends and writes back: two processes saving at once lose one entry. Hold a lock on a
+    file beside it while saving."""
+    from numba.core import caching
+
+    save = caching.IndexDataCacheFile.save
+
+    def locked_save(self, key, data):
+        with open(self._index_path + ".lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            save(self, key, data)
+
+    caching.IndexDataCacheFile.save = locked_save
+    try:
+        yield
+    finally:
+        caching.IndexDataCacheFile.save = save
+
+
+def warm(names):
+    """Compile the canonical variants ``names`` (into the numba cache); {name: [signature]}."""
+    from sim.pipeline.runner import build_engine
+
+    made = {}
+    with cache_index_lock():
+        for name in names:
+            before = compiled()
+            scene, *overrides = CANONICAL[name]
+            build_engine(compose_scene(scene, *overrides)).run(contacts=200)
+            made[name] = sorted(compiled() - before)
+    return made
+
+
+def shares(names, processes):
+    """``names`` split into ``processes`` lists of about equal compilation (longest first,
+    each to the least loaded list)."""
+    lists = [[] for _ in range(processes)]
+    load = [0] * processes
+    for name in sorted(names, key=lambda n: -VARIANTS.get(n, 1)):
+        k = load.index(min(load))
+        lists[k].append(name)
+        load[k] += VARIANTS.get(name, 1)
+    return [names for names in lists if names]
+
+
+if __name__ == "__main__":
+    print(json.dumps(warm(sys.argv[1:])))
