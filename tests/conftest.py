@@ -140,7 +140,7 @@ def pytest_sessionstart(session):
     config.stash[CANONICAL_KEY] = {s for signatures in made.values() for s in signatures}
     config.stash[WARM_KEY] = (len(config.stash[CANONICAL_KEY]), len(warming),
                               time.perf_counter() - started)
-    config.stash[CACHED_KEY] = variants.cached()
+    config.stash[CACHED_KEY] = set(variants.cached())
 
 
 def pytest_sessionfinish(session):
@@ -151,9 +151,10 @@ def pytest_sessionfinish(session):
     if (hasattr(config, "workerinput") or CACHED_KEY not in config.stash
             or config.option.markexpr != "not slow"):
         return
-    outside = variants.cached() - config.stash[CACHED_KEY] - config.stash[CANONICAL_KEY]
+    cached = variants.cached()
+    outside = cached.keys() - config.stash[CACHED_KEY] - config.stash[CANONICAL_KEY]
     if outside:
-        config.stash[OUTSIDE_KEY] = sorted(variants.describe(s) for s in outside)
+        config.stash[OUTSIDE_KEY] = sorted(variants.describe(cached[s]) for s in outside)
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 
@@ -174,13 +175,12 @@ def compiles_only_canonical_variants(request):
     after which this process holds another (compiled by the test or by a fixture it uses)
     fails, naming it. A slow test may compile any."""
     yield
-    outside = variants.compiled() - request.config.stash[CANONICAL_KEY] - _SEEN_OUTSIDE
+    compiled = variants.compiled()
+    outside = compiled.keys() - request.config.stash[CANONICAL_KEY] - _SEEN_OUTSIDE
     _SEEN_OUTSIDE.update(outside)
     if not outside or request.node.get_closest_marker("slow"):
         return
-    from sim.engine.loop import run_events
-
-    named = [variants.describe(s) for s in run_events.signatures if str(s) in outside]
     pytest.fail("compiled a variant of run_events outside the canonical set "
                 "(tests/variants.py); use a canonical scene or mark the test slow:\n"
-                + "\n".join(named), pytrace=False)
+                + "\n".join(variants.describe(compiled[s]) for s in sorted(outside)),
+                pytrace=False)

@@ -14,6 +14,7 @@ from sim.engine.kinematics import DISK_COLUMNS, VX, VY, X, Y
 from sim.engine.neighbours import shell_centre
 from sim.engine.sizing import LIST_GROWTH, packing_fraction_around_disks, shell_ratio
 from sim.pipeline.initial import PlacementError, hexagonal_lattice, random_sequential
+from variants import UNREACHED_THERMAL_WALL
 
 
 def triangle_wave(s, low, high):
@@ -296,12 +297,6 @@ def test_rebased_clock_keeps_the_trajectory():
     assert b.accumulators[0] > 0.0  # b's clock was restarted (its origin moved)
     d = a.positions(a.time) - b.positions(a.time)
     assert np.abs(d - np.round(d)).max() < 1e-9
-
-
-#: a thermal top wall that disks moving along y = 0.5 never reach: with it, inelastic disks
-#: without the TC model run the compiled loop of the driven scene (tests/variants.py), and
-#: nothing else changes
-UNREACHED_THERMAL_WALL = {"top": {"temperature": 1.0}}
 
 
 def test_inelastic_collapse_is_detected_and_tc_cures_it():

@@ -25,6 +25,7 @@ from sim.pipeline.initial import (
     radius_for_packing,
     random_sequential,
 )
+from variants import RECORDER_KEYWORDS, UNREACHED_THERMAL_WALL
 
 
 def refused(match, *args, **options):
@@ -231,12 +232,6 @@ def test_a_chain_creeping_round_a_periodic_box_is_a_stall(options, chunk_events)
     assert engine.time < 1e-12
 
 
-#: a thermal top wall that disks moving along a row at y = 0.5 never reach: with it,
-#: inelastic disks without the TC model run the compiled loop of the driven scene
-#: (tests/variants.py), and nothing else changes
-UNREACHED_THERMAL_WALL = {"top": {"temperature": 1.0}}
-
-
 def test_an_inelastic_chain_without_tc_collapses():
     """The ring of the test above, inelastic and without the TC model, with walls along y
     that it never reaches (every contact normal along x): collapse, not a stall."""
@@ -341,7 +336,7 @@ def test_a_checkpoint_of_another_scene_is_refused_before_anything_changes():
     larger = gas(120, 0.3, seed=1)
     with pytest.raises(ValueError, match="disks/table has shape"):
         engine.load_state_dict(larger.state_dict())
-    recording = gas(100, 0.3, seed=1, unwrap=True, pressure_tensor=True, event_log=1000)
+    recording = gas(100, 0.3, seed=1, **RECORDER_KEYWORDS)
     with pytest.raises(ValueError, match=r"unknown \['disks/images', 'virial_tensor'\]"):
         engine.load_state_dict(recording.state_dict())
     for key, value in engine.state_dict().items():

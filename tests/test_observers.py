@@ -8,6 +8,7 @@ from sim.analysis.datasets import contacts, granular_temperatures, open_run, pre
 from sim.analysis.theory import kolafa_rottner_z
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
+from variants import RECORDER_KEYWORDS, RECORDERS
 
 
 def test_radial_distribution_of_a_dense_gas(tmp_path):
@@ -79,12 +80,6 @@ def test_local_fields_add_up_to_the_whole_gas(tmp_path):
     assert pooled == pytest.approx(heat / np.sum(counts[counts > 1] - 1.0), rel=1e-12)
 
 
-#: every recorder of the event loop on (unwrapped positions, pressure tensor, event log): the
-#: compiled loop the quick tests of any of them share (tests/variants.py)
-RECORDERS = ("observe.mean_squared_displacement=true", "observe.pressure_tensor=true",
-             "observe.event_log=true")
-
-
 def periodic_gas(tmp_path, *overrides):
     """A periodic gas at φ = 0.3, T = 1, with every recorder on."""
     cfg = compose_config(["box.boundary=periodic", "disks.packing_fraction=0.3",
@@ -104,9 +99,8 @@ def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
     position = random_sequential(np.full(n, radius), periodic=(True, True), seed=4)
     velocity = np.random.default_rng(5).normal(size=(n, 2)) * 10.0
     # every recorder on: the unwrapped positions are the test's, the others share the loop
-    recorders = {"unwrap": True, "pressure_tensor": True, "event_log": 1000}
     engine = Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
-                    **recorders)
+                    **RECORDER_KEYWORDS)
     unwrapped = engine.positions(0.0)
     previous = unwrapped.copy()
     for t in np.arange(1, 400) * 2e-3:  # at most 0.02 × 10 × a few σ < L/2 per step
@@ -118,7 +112,7 @@ def test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots():
     assert np.abs(unwrapped - position).max() > 2.0  # disks crossed the box several times
 
     lone = Engine([[0.5, 0.5]], [[3.0, -4.0]], 0.01, boundary=Boundary(periodic=(True, True)),
-                  **recorders)
+                  **RECORDER_KEYWORDS)
     lone.run(time=10.0)
     np.testing.assert_allclose(lone.unwrapped_positions(10.0), [[30.5, -39.5]], rtol=1e-14)
 
@@ -215,7 +209,7 @@ def test_event_log_streams_to_the_file_between_snapshots(tmp_path):
     radius = radius_for_packing(n, 0.2)
     # with the other recorders on: the compiled loop of the quick tests of any of them
     engine = Engine(random_sequential(np.full(n, radius), seed=1), fixed_speed(n, 1.0, seed=2),
-                    radius, event_log=1000, unwrap=True, pressure_tensor=True)
+                    radius, **RECORDER_KEYWORDS)
     writer = RunWriter(tmp_path / "run.h5", engine, {"config": "scene: gas\n", "seed": 0},
                        buffer_bytes=48 * 2000)
     writer.snapshot(engine, 0.0)

@@ -1,7 +1,7 @@
 """Rough disks in the engine (sim.effects.rotation): energy and momentum bookkeeping over many
 contacts, smooth disks unchanged, spins renumbered with the disks and restored from a
-checkpoint to the same bits, the run file's spins, and the config's one-line refusals."""
-
+checkpoint to the same bits, and the run file's spins (the config's one-line refusals are
+test_hostile.py's)."""
 
 import h5py
 import numpy as np

@@ -19,7 +19,7 @@ def test_a_variant_is_named_by_its_effects_and_what_is_per_disk():
     from sim.engine.loop import run_events
 
     gas(50, 0.2, periodic=(True, True))  # the gas scene's variant
-    gas(50, 0.2, periodic=(True, True), unwrap=True, pressure_tensor=True, event_log=100)
+    gas(50, 0.2, periodic=(True, True), **variants.RECORDER_KEYWORDS)
     named = {variants.describe(s).split("; types")[0] for s in run_events.signatures}
     assert "effects: none; per disk: none" in named
     assert "effects: images, virial_tensor, event_log; per disk: none" in named

@@ -51,9 +51,16 @@ SHRINK = {"gas": ["disks.n=300"], "mixture": ["disks.n=300"], "cooling": ["disks
           "crater": ["bed.n=400", "projectile.radius=0.02"],
           "crater_gravity": ["bed.n=300", "bed.radius=0.012", "bed.settle_time=0.5"]}
 
-#: the recorders of the loop (unwrapped positions, pressure tensor, event log) on a periodic gas
-OBSERVERS = ("box.boundary=periodic", "observe.mean_squared_displacement=true",
-             "observe.pressure_tensor=true", "observe.event_log=true")
+#: every recorder of the loop on (unwrapped positions, pressure tensor, event log), as config
+#: overrides and as Engine keywords: a test of any of them shares the loop of the others
+RECORDERS = ("observe.mean_squared_displacement=true", "observe.pressure_tensor=true",
+             "observe.event_log=true")
+RECORDER_KEYWORDS = {"unwrap": True, "pressure_tensor": True, "event_log": 1000}
+#: the recorders on a periodic gas
+OBSERVERS = ("box.boundary=periodic", *RECORDERS)
+#: a thermal top wall that disks moving along y = 0.5 never reach: with it, inelastic disks
+#: without the TC model run the driven scene's loop, and nothing else changes
+UNREACHED_THERMAL_WALL = {"top": {"temperature": 1.0}}
 
 #: name → (scene, overrides) of the variants the quick suite compiles: the shipped scenes
 #: (single_disk, two_disks and scattering compile one of these; the tests that run every
@@ -76,30 +83,23 @@ def compose_scene(name, *overrides):
 
 
 def compiled():
-    """The signatures of ``run_events`` this process has compiled or loaded, as text."""
+    """{text: signature} of ``run_events`` as this process has compiled or loaded it."""
     loop = sys.modules.get("sim.engine.loop")
-    return set() if loop is None else {str(s) for s in loop.run_events.signatures}
+    return {} if loop is None else {str(s): s for s in loop.run_events.signatures}
 
 
 def cached():
-    """The signatures of ``run_events`` in the numba cache (text): what every process of the
+    """{text: signature} of ``run_events`` in the numba cache: what every process of the
     session compiled, subprocesses of ``python -m sim`` included. (numba keeps them in one
     index per function, keyed by (signature, target, code hash).)"""
     from sim.engine.loop import run_events
 
-    return {str(key[0]) for key in run_events._cache._cache_file._load_index()}
+    return {str(key[0]): key[0] for key in run_events._cache._cache_file._load_index()}
 
 
 def describe(signature):
-    """A signature of ``run_events`` (its types, or their text) in words: the effects on,
-    and what is per disk."""
+    """A signature of ``run_events`` in words: the effects on, and what is per disk."""
     from numba import types
-
-    if isinstance(signature, str):
-        from sim.engine.loop import run_events
-
-        signature = next(key[0] for key in run_events._cache._cache_file._load_index()
-                         if str(key[0]) == signature)
 
     def named(group):
         return dict(zip(group.fields, group.types, strict=True))
@@ -142,10 +142,10 @@ def warm(names):
     made = {}
     with cache_index_lock():
         for name in names:
-            before = compiled()
+            before = compiled().keys()
             scene, *overrides = CANONICAL[name]
             build_engine(compose_scene(scene, *overrides)).run(contacts=200)
-            made[name] = sorted(compiled() - before)
+            made[name] = sorted(compiled().keys() - before)
     return made
 
 
