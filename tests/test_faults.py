@@ -55,7 +55,7 @@ def run_until_killed(folder, after_seconds, how):
     return process.returncode, err
 
 
-@pytest.mark.parametrize("after_seconds", [0.3, 1.1])
+@pytest.mark.parametrize("after_seconds", [0.3, pytest.param(1.1, marks=pytest.mark.slow)])
 def test_a_run_killed_at_any_moment_opens_and_resumes_to_the_same_bits(
         after_seconds, uninterrupted, tmp_path):
     code, _ = run_until_killed(tmp_path, after_seconds, signal.SIGKILL)

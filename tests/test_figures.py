@@ -8,6 +8,7 @@ import pytest
 
 from sim.figures import STAGES
 from sim.figures.__main__ import main
+from sim.figures.making import batches
 
 FIGURES = {"single_disk": "fig01_single_disk", "two_disks": "fig02_two_disks",
            "scattering": "fig03_scattering", "gas_snapshot": "fig04_gas_snapshot",
@@ -142,13 +143,21 @@ def check(out, stages):
 
 
 def test_quick_figures_of_the_small_scenes(tmp_path):
-    main(["--quick", "--out", str(tmp_path), "--only", *QUICK_STAGES])
+    main(["--quick", "--out", str(tmp_path), "--jobs", "2", "--only", *QUICK_STAGES])
     out = tmp_path / "quick"
     check(out, QUICK_STAGES)
     # a second call finds its runs and makes none again
     stamp = {p: p.stat().st_mtime for p in out.rglob("run.h5")}
-    main(["--quick", "--out", str(tmp_path), "--only", "single_disk"])
+    main(["--quick", "--out", str(tmp_path), "--jobs", "1", "--only", "single_disk"])
     assert {p: p.stat().st_mtime for p in out.rglob("run.h5")} == stamp
+
+
+def test_stages_that_read_one_run_are_made_in_one_process(tmp_path):
+    groups = batches(list(STAGES), True, tmp_path)
+    assert sorted(name for group in groups for name in group) == sorted(STAGES)
+    # the gas snapshot and its speed distribution read one run
+    assert ["gas_snapshot", "maxwell_boltzmann"] in groups
+    assert len(groups) == len(STAGES) - 1
 
 
 @pytest.mark.slow

@@ -18,7 +18,7 @@ import pytest
 from conftest import assert_no_overlap, gas
 from sim.engine import Boundary, Engine
 from sim.pipeline.runner import build_engine
-from variants import SCENARIOS, compose_scene
+from variants import compose_scene, scenario_params
 
 FINGERPRINTS = Path(__file__).with_name("fingerprints.json")
 RECORD = os.environ.get("SIM_RECORD_FINGERPRINTS") == "1"
@@ -138,7 +138,7 @@ def test_engine_scene_keeps_its_bits(name):
     _check(name, engine)
 
 
-@pytest.mark.parametrize("name", SCENARIOS)
+@pytest.mark.parametrize("name", scenario_params())
 def test_scenario_keeps_its_bits(name):
     engine = build_engine(compose_scene(name))
     engine.run(contacts=5_000)

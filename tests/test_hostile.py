@@ -693,25 +693,23 @@ def test_another_sweep_into_a_sweep_folder_is_refused_before_any_job(swept, tmp_
           nothing_new=True)
 
 
-def test_the_same_sweep_again_changes_nothing_and_reads_back_labelled(tmp_path):
-    """Run twice into one folder (a copy of the folder would differ in the paths Hydra
-    records): the second run finds every job complete and writes nothing."""
+def test_the_same_sweep_again_changes_nothing_and_reads_back_labelled(swept):
+    """Run again into the sweep's own folder (a copy of the folder would differ in the paths
+    Hydra records): it finds every job complete and writes nothing."""
     from sim.analysis.datasets import open_sweep
 
-    result = sim(*SWEEP, "hydra.sweep.dir=S", "-m", cwd=tmp_path)
-    assert result.code == 0, result.err[-2000:]
-    before = tree(tmp_path)
-    result = sim(*SWEEP, "hydra.sweep.dir=S", "-m", cwd=tmp_path)
-    check(result, 0, [], before, tree(tmp_path), nothing_new=True)
+    folder = swept.parent
+    before = tree(folder)
+    result = sim(*SWEEP, "hydra.sweep.dir=S", "-m", cwd=folder)
+    check(result, 0, [], before, tree(folder), nothing_new=True)
     assert result.out.count("is complete") == 2
-    sweep = open_sweep(tmp_path / "S")
+    sweep = open_sweep(swept)
     labels = sweep["restitution_disk"].values.tolist()
     assert labels == [0.9, 1.0]
     for value in labels:
         config = yaml.safe_load(str(sweep["config"].sel(restitution_disk=value).item()))
         assert config["restitution"]["disk"] == value
-    recorded = sorted(stored(p)[0]["restitution"]["disk"]
-                      for p in (tmp_path / "S").glob("*/run.h5"))
+    recorded = sorted(stored(p)[0]["restitution"]["disk"] for p in swept.glob("*/run.h5"))
     assert recorded == labels
 
 

@@ -16,10 +16,10 @@ from sim.pipeline.config import ConfigError
 from sim.storage.errors import RunFileError
 from sim.storage.h5md import RunWriter
 from sim.storage.inspect import summary
-from variants import OBSERVERS, SCENARIOS, compose_scene
+from variants import OBSERVERS, compose_scene, scenario_params
 
 
-@pytest.mark.parametrize("name", SCENARIOS)
+@pytest.mark.parametrize("name", scenario_params())
 def test_every_scenario_runs_and_writes_h5md(name, tmp_path):
     cfg = compose_scene(name, "stop.collisions=300", "stop.contacts=1000",
                         "output.every_collisions=null", "output.every_time=2.0")

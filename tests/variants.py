@@ -4,10 +4,11 @@ numba compiles :func:`sim.engine.loop.run_events` anew for every combination of 
 types: every effect on or off (:class:`sim.effects.Effects`), mass, species and shell radius
 shared or per disk, list capacities shared or per disk. Each combination costs about 20 s of
 compilation and almost nothing to run, so the quick suite keeps to a canonical set:
-:data:`CANONICAL`, the variants that the shipped scenes compile, and one with every observer
-on. Before the tests start, ``conftest.py`` compiles them into the numba cache in as many
-processes as there are workers (``python tests/variants.py NAME ...``), and every quick test
-fails that compiles a variant outside the set, naming it (:func:`describe`).
+:data:`CANONICAL`, the variants that the shipped scenes compile (but crater_gravity's crater
+under gravity, :data:`SLOW_SCENARIOS`), and one with every observer on. Before the tests
+start, ``conftest.py`` compiles them into the numba cache in as many processes as there are
+workers (``python tests/variants.py NAME ...``), and every quick test fails that compiles a
+variant outside the set, naming it (:func:`describe`).
 
 Budget: a new effect or interaction adds at most one canonical variant (its scene); a test
 that needs another combination is ``slow``.
@@ -25,14 +26,12 @@ vibrated_bed    ``restitution``, ``wall_restitution`` < 1, ``tc``, ``gravity`` a
                 vibrating wall
 crater          ``restitution``, ``wall_restitution``, ``tc``; masses and species per disk and
                 one disk far larger than the rest (list capacities per disk)
-crater_gravity  as crater with ``gravity``; and without the large disk, every disk alike
+settling_bed    ``restitution``, ``wall_restitution``, ``tc`` and ``gravity``, every disk alike
 rough_cooling   ``restitution``, ``tangential_restitution`` (rough, no friction) and ``tc``
 observers       ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk alike
 ==============  ================================================================================
 """
 
-import contextlib
-import fcntl
 import json
 import sys
 from pathlib import Path
@@ -62,16 +61,20 @@ OBSERVERS = ("box.boundary=periodic", *RECORDERS)
 #: without the TC model run the driven scene's loop, and nothing else changes
 UNREACHED_THERMAL_WALL = {"top": {"temperature": 1.0}}
 
+#: shipped scenes whose runs are slow: crater_gravity settles its bed (a canonical variant,
+#: ``settling_bed``) and then compiles the crater under gravity, for what crater and
+#: vibrated_bed check quickly
+SLOW_SCENARIOS = ("crater_gravity",)
 #: name → (scene, overrides) of the variants the quick suite compiles: the shipped scenes
-#: (single_disk, two_disks and scattering compile one of these; the tests that run every
-#: scene check it) and a gas with every recorder on
+#: but :data:`SLOW_SCENARIOS` (single_disk, two_disks and scattering compile one of these;
+#: the tests that run every scene check it), crater_gravity's bed settling (inelastic disks
+#: alike under gravity with the TC model: disks at rest on a still floor) and a gas with every
+#: recorder on
 CANONICAL = {**{scene: (scene,) for scene in ("gas", "mixture", "cooling", "driven",
-                                               "vibrated_bed", "crater", "crater_gravity",
-                                               "rough_cooling")},
+                                               "vibrated_bed", "crater", "rough_cooling")},
+             "settling_bed": ("gas", "gravity=[0,-1]", "restitution.disk=0.9",
+                              "restitution.wall=0.9", "tc.time=1e-4"),
              "observers": ("gas", *OBSERVERS)}
-#: compiled variants of a canonical entry when more than one: crater_gravity settles its bed
-#: before it adds the projectile
-VARIANTS = {"crater_gravity": 2}
 
 
 def compose_scene(name, *overrides):
@@ -114,51 +117,30 @@ def describe(signature):
             f"types: {signature}")
 
 
-@contextlib.contextmanager
-def cache_index_lock():
-    """numba's cache index of a function is one file that every process compiling it reads,
-    extends and writes back: two processes saving at once lose one entry. Hold a lock on a
-    file beside it while saving."""
-    from numba.core import caching
-
-    save = caching.IndexDataCacheFile.save
-
-    def locked_save(self, key, data):
-        with open(self._index_path + ".lock", "w") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)
-            save(self, key, data)
-
-    caching.IndexDataCacheFile.save = locked_save
-    try:
-        yield
-    finally:
-        caching.IndexDataCacheFile.save = save
-
-
 def warm(names):
     """Compile the canonical variants ``names`` (into the numba cache); {name: [signature]}."""
     from sim.pipeline.runner import build_engine
 
     made = {}
-    with cache_index_lock():
-        for name in names:
-            before = compiled().keys()
-            scene, *overrides = CANONICAL[name]
-            build_engine(compose_scene(scene, *overrides)).run(contacts=200)
-            made[name] = sorted(compiled().keys() - before)
+    for name in names:
+        before = compiled().keys()
+        scene, *overrides = CANONICAL[name]
+        build_engine(compose_scene(scene, *overrides)).run(contacts=200)
+        made[name] = sorted(compiled().keys() - before)
     return made
 
 
 def shares(names, processes):
-    """``names`` split into ``processes`` lists of about equal compilation (longest first,
-    each to the least loaded list)."""
-    lists = [[] for _ in range(processes)]
-    load = [0] * processes
-    for name in sorted(names, key=lambda n: -VARIANTS.get(n, 1)):
-        k = load.index(min(load))
-        lists[k].append(name)
-        load[k] += VARIANTS.get(name, 1)
-    return [names for names in lists if names]
+    """``names`` dealt into ``processes`` lists of about equal length (one variant each)."""
+    return [names[k::processes] for k in range(min(processes, len(names)))]
+
+
+def scenario_params():
+    """:data:`SCENARIOS` as pytest parameters, those of :data:`SLOW_SCENARIOS` marked slow."""
+    import pytest
+
+    return [pytest.param(name, marks=pytest.mark.slow) if name in SLOW_SCENARIOS else name
+            for name in SCENARIOS]
 
 
 if __name__ == "__main__":

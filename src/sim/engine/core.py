@@ -137,6 +137,7 @@ class Engine(Running, Observables, Checkpoints):
                                        self.initial_energy, mass, self.gravity,
                                        self.wall_motion, self.wall_temperature)
         self.stall_watch = np.array([-math.inf, 0.0])
+        self._compiled_layout = None  # the list layout whose loop variant compile_once made
         self._build(position, velocity, shell, shell_lead, list_capacity, disk_effects,
                     first_event_time(box, velocity, self.gravity, self.wall_motion))
         self.initial_energy += self.rotational_energy()

@@ -9,6 +9,7 @@ import numpy as np
 
 from sim.effects.walls import piston_jam
 from sim.engine import codes, loop
+from sim.engine.compilation import compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
 from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
 from sim.engine.kinematics import VX, VY, X, Y
@@ -30,7 +31,7 @@ class Running:
             d = self.disks
             every = self.reorder_every
             reorder_at = (self.counters[codes.EVENTS] // every + 1) * every
-            status, disk = loop.run_events(
+            arguments = (
                 Disks(d.table, *self._per_disk_parameters(), d.coll_count, d.contacts,
                       d.t_last, d.streak),
                 Schedule(d.event_time, d.event_partner, d.event_count, *d.queue),
@@ -42,6 +43,12 @@ class Running:
                         self.wall_impulse, self.stall_watch),
                 Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
                        dissipation_limit, self.stall_dt, self.rebase_every, self.lookahead))
+            # the loop's variant is the engine's but for the lists' layout, which may change
+            layout = self._common_capacity is None
+            if self._compiled_layout is not layout:
+                compile_once(loop.run_events, arguments)
+                self._compiled_layout = layout
+            status, disk = loop.run_events(*arguments)
             self.drain_event_log()
             if status == codes.STATUS_LOG_FULL:
                 continue

@@ -1,19 +1,30 @@
-"""``python -m sim.figures [--quick] [--only NAME …]``: make the runs, then every figure.
+"""``python -m sim.figures [--quick] [--only NAME …] [--jobs J]``: make the runs, then every
+figure.
 
 Figures and their numbers go to ``outputs/figures/`` (``--out``), the runs they read to
 ``outputs/figures/runs/``; runs whose resolved config is unchanged are not made again. The
-wall-clock seconds of each stage (its runs and its drawing) go to ``timings.csv`` there.
+stages run in ``--jobs`` processes at once, the longest first by the seconds they last took:
+by default one process more than the cores, as a process that waits for a variant of the
+event loop another compiles (each is compiled once, :mod:`sim.engine.compilation`), or for
+its sweep's jobs, leaves its core to the others. Stages that read a common run or sweep run
+one after the other in one process. The wall-clock seconds of each stage in its process (its
+runs, its drawing, and any wait) go to ``timings.csv`` there.
 """
 
 import argparse
 import csv
-import importlib
-import time
+import os
+from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
+from multiprocessing import get_context
 from pathlib import Path
 
 from sim.figures import STAGES
+from sim.figures.making import batches, make_stages, stage_module
 from sim.figures.style import QUICK_FOLDER
-from sim.pipeline.run_cache import ensure_run, ensure_sweep
+
+
+def _cores():
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
 def main(argv=None):
@@ -21,6 +32,9 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="small versions (CI)")
     parser.add_argument("--only", nargs="+", choices=STAGES, help="these stages only")
     parser.add_argument("--out", default="outputs/figures", help="output folder")
+    parser.add_argument("--jobs", type=int, default=_cores() + 1,
+                        help="stages at once (default: one more than the cores; 1: all in "
+                             "this process)")
     args = parser.parse_args(argv)
     out = Path(args.out) / (QUICK_FOLDER if args.quick else "")
     out.mkdir(parents=True, exist_ok=True)
@@ -29,22 +43,34 @@ def main(argv=None):
     if timings_path.exists():
         with open(timings_path, newline="") as f:
             timings = {row["stage"]: row["seconds"] for row in csv.DictReader(f)}
-    for name in args.only or STAGES:
-        stage = importlib.import_module(f"sim.figures.{name}")
-        started = time.perf_counter()
-        wanted_runs = stage.runs(args.quick) if hasattr(stage, "runs") else {}
-        wanted_sweeps = stage.sweeps(args.quick) if hasattr(stage, "sweeps") else {}
-        runs = {label: ensure_run(label, overrides, out / "runs")
-                for label, overrides in wanted_runs.items()}
-        sweeps = {label: ensure_sweep(label, overrides, out / "runs")
-                  for label, overrides in wanted_sweeps.items()}
-        path = stage.draw(runs, sweeps, out)
-        seconds = time.perf_counter() - started
-        print(f"{stage.NAME}: {path} ({seconds:.1f} s)")
-        timings[stage.NAME] = f"{seconds:.1f}"
+    names = list(args.only or STAGES)
+    groups = sorted(batches(names, args.quick, out),
+                    key=lambda g: -sum(float(timings.get(stage_module(n).NAME, 0.0)) for n in g))
+    for stage_name, path, seconds in made(groups, args.quick, out, args.jobs):
+        print(f"{stage_name}: {path} ({seconds:.1f} s)", flush=True)
+        timings[stage_name] = f"{seconds:.1f}"
         with open(timings_path, "w", newline="") as f:
             f.write("stage,seconds\n")
             f.writelines(f"{key},{value}\n" for key, value in timings.items())
+
+
+def made(groups, quick, out, jobs):
+    """(stage NAME, what it wrote, seconds) of every stage of ``groups`` as it is made: in
+    ``jobs`` processes, or in this one for a single job."""
+    if jobs <= 1:
+        for group in groups:
+            yield from make_stages(group, quick, out)
+        return
+    with ProcessPoolExecutor(jobs, mp_context=get_context("spawn")) as pool:
+        pending = {pool.submit(make_stages, group, quick, out) for group in groups}
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_EXCEPTION)
+            for future in done:
+                if future.exception() is not None:
+                    for other in pending:
+                        other.cancel()  # those not started; the running ones finish
+                    raise future.exception()
+                yield from future.result()
 
 
 if __name__ == "__main__":

@@ -39,11 +39,21 @@ def _digest(text):
     return hashlib.sha1(text.encode()).hexdigest()[:10]
 
 
+def _run_config(label, overrides, root):
+    """The config of a run of ``overrides`` and its folder under ``root``."""
+    cfg = compose_config([*overrides, "output.progress=false"])
+    return cfg, Path(root) / f"{label}-{_digest(_identity(cfg))}"
+
+
+def cached_run_folder(label, overrides, root):
+    """The folder under ``root`` of the run of ``overrides`` (:func:`ensure_run`)."""
+    return _run_config(label, overrides, root)[1]
+
+
 def ensure_run(label, overrides, root):
     """The run file of ``overrides`` under ``root``, simulated only if not there yet (a run
     cut short there is resumed, :func:`sim.pipeline.runner.run`)."""
-    cfg = compose_config([*overrides, "output.progress=false"])
-    folder = Path(root) / f"{label}-{_digest(_identity(cfg))}"
+    cfg, folder = _run_config(label, overrides, root)
     folder.mkdir(parents=True, exist_ok=True)
     return run(cfg, folder)
 
@@ -57,14 +67,20 @@ def _first_value(override):
     return f"{parsed.get_key_element()}={next(iter(parsed.sweep_string_iterator()))}"
 
 
-def ensure_sweep(label, overrides, root):
-    """The directory of a Hydra multirun over ``overrides`` (with comma lists), run only if
-    it has not completed before: keyed by the overrides and the resolved config of its first
-    job, so that a changed scene file makes the sweep again."""
+def cached_sweep_folder(label, overrides, root):
+    """The directory under ``root`` of the sweep over ``overrides`` (:func:`ensure_sweep`):
+    named by the overrides and the resolved config of its first job, so that a changed scene
+    file makes the sweep again."""
     first_job = [_first_value(o) for o in overrides]
     key = " ".join(sorted(overrides)) + _identity(
         compose_config([*first_job, "output.progress=false"]))
-    folder = Path(root) / f"{label}-{_digest(key)}"
+    return Path(root) / f"{label}-{_digest(key)}"
+
+
+def ensure_sweep(label, overrides, root):
+    """The directory of a Hydra multirun over ``overrides`` (with comma lists), run only if
+    it has not completed before (:func:`cached_sweep_folder`)."""
+    folder = cached_sweep_folder(label, overrides, root)
     if not (folder / "sweep_summary.yaml").exists():
         command = [sys.executable, "-m", "sim", *overrides, "output.progress=false",
                    f"hydra.sweep.dir={folder}", "-m"]

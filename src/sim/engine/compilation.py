@@ -1,0 +1,62 @@
+"""Each variant of the event loop compiled by one process, and numba's cache kept whole.
+
+numba compiles :func:`sim.engine.loop.run_events` anew for every combination of its argument
+types (a *variant*: the effects a scene uses, what is per disk), in about 20 s, and keeps it
+in its cache folder (``NUMBA_CACHE_DIR``, one per version of the sources, :mod:`sim`).
+Processes that start together on a cold cache — the jobs of a sweep, the figure stages, the
+test workers — would each compile the same variant; and two processes that save to the cache
+at once can each drop the other's entry from the function's index, or number their code files
+alike and leave an entry pointing at the other's code. So:
+
+* :func:`compile_once`: a process that does not hold a variant compiles it under a lock named
+  after it in the cache folder; the others wait and then load it from the cache;
+* numba's cache saves an entry (index and code) under a lock of the function's index.
+
+Both locks are ``flock(2)`` locks, released by the system when their process ends.
+"""
+
+import contextlib
+import fcntl
+import os
+import zlib
+
+from numba.core import caching
+
+
+@contextlib.contextmanager
+def _held(path):
+    """An exclusive ``flock`` on the file ``path`` (made if missing) for the block."""
+    with open(path, "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+
+
+def compile_once(function, arguments):
+    """Compile, or load from the cache, the variant of the compiled ``function`` that
+    ``arguments`` (a tuple) call, holding the lock of that variant, unless this process holds
+    it already. Typing the arguments takes about 0.3 ms: call it once per engine and list
+    layout, not per call."""
+    signature = tuple(function.typeof_pyval(a) for a in arguments)
+    if signature in function.overloads:
+        return
+    folder = os.environ["NUMBA_CACHE_DIR"]
+    os.makedirs(folder, exist_ok=True)
+    name = f"{function.__name__}-{zlib.crc32(str(signature).encode()):08x}.lock"
+    with _held(os.path.join(folder, name)):
+        function.compile(signature)
+
+
+def _saved_under_lock(save):
+    """numba's ``IndexDataCacheFile.save`` (read the index, add the entry, write index and
+    code) holding a lock beside the index."""
+
+    def save_under_lock(self, key, data):
+        with _held(self._index_path + ".lock"):
+            save(self, key, data)
+
+    save_under_lock.__wrapped__ = save
+    return save_under_lock
+
+
+if not hasattr(caching.IndexDataCacheFile.save, "__wrapped__"):
+    caching.IndexDataCacheFile.save = _saved_under_lock(caching.IndexDataCacheFile.save)
