@@ -29,6 +29,14 @@ def test_a_variant_not_held_is_compiled_under_a_lock_of_its_own(tmp_path, monkey
     assert len(held) == 2 and held[0] != held[1]
 
 
+def test_a_lock_that_cannot_be_made_is_passed_over(tmp_path):
+    (tmp_path / "a_file").write_text("")
+    entered = False
+    with compilation._held(str(tmp_path / "a_file" / "x.lock")):
+        entered = True
+    assert entered
+
+
 def test_the_cache_saves_its_entries_under_a_lock():
     from numba.core import caching
 

@@ -25,8 +25,16 @@ from numba.core import caching
 
 @contextlib.contextmanager
 def _held(path):
-    """An exclusive ``flock`` on the file ``path`` (made if missing) for the block."""
-    with open(path, "a") as handle:
+    """An exclusive ``flock`` on the file ``path`` (made, with its folder, if missing) for the
+    block; none where it cannot be made (a read-only cache folder, where numba caches
+    nothing either)."""
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        handle = open(path, "a")
+    except OSError:
+        yield
+        return
+    with handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
         yield
 
@@ -36,13 +44,13 @@ def compile_once(function, arguments):
     ``arguments`` (a tuple) call, holding the lock of that variant, unless this process holds
     it already. Typing the arguments takes about 0.3 ms: call it once per engine and list
     layout, not per call."""
+    if not hasattr(function, "overloads"):
+        return  # NUMBA_DISABLE_JIT: plain Python, nothing to compile
     signature = tuple(function.typeof_pyval(a) for a in arguments)
     if signature in function.overloads:
         return
-    folder = os.environ["NUMBA_CACHE_DIR"]
-    os.makedirs(folder, exist_ok=True)
     name = f"{function.__name__}-{zlib.crc32(str(signature).encode()):08x}.lock"
-    with _held(os.path.join(folder, name)):
+    with _held(os.path.join(os.environ["NUMBA_CACHE_DIR"], name)):
         function.compile(signature)
 
 
