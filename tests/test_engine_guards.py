@@ -143,6 +143,62 @@ def test_bad_values_are_refused_naming_the_disk_or_parameter():
     assert Engine(position, velocity, 0.02, seed=2**63 - 1).seed == 2**63 - 1
 
 
+def test_the_engine_refuses_what_is_not_real_numbers_naming_the_argument():
+    position, velocity = [[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]]
+    refused(r"Engine\(position=…\) is not allowed: real numbers", [[0.3 + 1j, 0.5], [0.7, 0.5]],
+            velocity, 0.01)
+    refused(r"Engine\(radius='0.01'\) is not allowed", position, velocity, "0.01")
+    refused(r"Engine\(velocity=…\)", position, [[1.0], [-1.0, 0.0]], 0.01)
+    refused(r"Engine\(species=…\) is not allowed: whole numbers", position, velocity, 0.01,
+            species=[0.5, 1])
+    refused(r"restitution must be one number or a 2 × 2 matrix .* shape \(3, 3\)", position,
+            velocity, 0.01, species=[0, 1], restitution=np.full((3, 3), 0.9))
+
+
+#: arguments of Engine.run that no run can take: (keywords, the words of the refusal)
+BAD_RUN_ARGUMENTS = {
+    "collisions-negative": ({"collisions": -5}, "collisions=-5"),
+    "collisions-fractional": ({"collisions": 2.7}, "collisions=2.7"),
+    "collisions-1e30": ({"collisions": 1e30}, "collisions=1e+30"),
+    "collisions-beyond-int64": ({"collisions": 2**63}, "collisions="),
+    "contacts-text": ({"contacts": "10"}, "contacts='10'"),
+    "events-bool": ({"events": True}, "events=True"),
+    "time-negative": ({"time": -1.0}, "time=-1.0"),
+    "time-nan": ({"time": np.nan}, "time=nan"),
+    "time-inf": ({"time": np.inf}, "time=inf"),
+    "time-complex": ({"time": 1 + 2j}, "time=(1+2j)"),
+    "energy_fraction-2": ({"energy_fraction": 2.0}, "energy_fraction=2.0"),
+    "energy_fraction-negative": ({"energy_fraction": -1}, "energy_fraction=-1"),
+    "energy_fraction-nan": ({"energy_fraction": np.nan}, "energy_fraction=nan"),
+    "wall_seconds-nan": ({"wall_seconds": np.nan}, "wall_seconds=nan"),
+    "wall_seconds-negative": ({"wall_seconds": -1}, "wall_seconds=-1"),
+    "chunk_events-0": ({"collisions": 1000, "chunk_events": 0}, "chunk_events=0"),
+    "chunk_events-negative": ({"collisions": 1000, "chunk_events": -3}, "chunk_events=-3"),
+    "until-not-callable": ({"until": 5}, "until=5"),
+    "nothing": ({}, "at least one stop condition"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_RUN_ARGUMENTS))
+def test_run_refuses_what_no_run_can_take_naming_the_argument(case):
+    """Engine.run checks its arguments as the command line checks ``stop``: a ValueError of
+    one line naming the argument and what is allowed, before any event."""
+    keywords, words = BAD_RUN_ARGUMENTS[case]
+    engine = gas(50, 0.2, seed=3)
+    with pytest.raises(ValueError) as refusal:
+        engine.run(**keywords)
+    message = str(refusal.value)
+    assert words in message and "\n" not in message
+    assert engine.events == 0 and engine.time == 0.0
+
+
+def test_run_takes_whole_floats_and_numpy_numbers():
+    engine = gas(50, 0.2, seed=3)
+    assert engine.run(collisions=1e3) == "collisions" and engine.collisions == 1000
+    assert engine.run(collisions=np.int64(1500), chunk_events=np.int32(100)) == "collisions"
+    assert engine.run(time=np.float32(engine.time + 0.5)) == "time"
+
+
 # -- 2. sizing that cannot overflow -----------------------------------------------------------
 def test_cell_count_is_capped_whatever_the_scale():
     for box, width, n in (((1.0, 1.0), 1e-40, 100), ((1e30, 1e30), 1e-3, 100),

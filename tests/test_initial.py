@@ -12,6 +12,7 @@ from sim.pipeline.initial import (
     hexagonal_lattice,
     maxwellian,
     melted_lattice,
+    radius_for_packing,
     random_sequential,
     remove_drift,
 )
@@ -96,3 +97,31 @@ def test_maxwellian_components_and_zero_drift():
     for m in (1.0, 4.0):
         components = v[mass == m].ravel()
         assert stats.kstest(components, stats.norm(scale=np.sqrt(0.7 / m)).cdf).pvalue > 1e-3
+
+
+#: arguments of the placement helpers that no scene can take: (call, the words of the refusal)
+BAD_ARGUMENTS = {
+    "lattice-no-disks": (lambda: hexagonal_lattice(0, 0.01), "hexagonal_lattice(n=0)"),
+    "lattice-fractional-n": (lambda: hexagonal_lattice(2.5, 0.01), "hexagonal_lattice(n=2.5)"),
+    "lattice-nan-radius": (lambda: hexagonal_lattice(10, np.nan), "entry 0 is nan"),
+    "lattice-negative-radius": (lambda: hexagonal_lattice(10, -0.01), "radius=…"),
+    "lattice-jitter-2": (lambda: hexagonal_lattice(10, 0.01, jitter=2.0), "jitter=2.0"),
+    "speeds-of-no-disks": (lambda: fixed_speed(-1, 1.0), "fixed_speed(n=-1)"),
+    "speeds-nan": (lambda: fixed_speed(3, np.nan), "fixed_speed(speed=nan)"),
+    "random-nan-radius": (lambda: random_sequential([0.01, np.nan]), "entry 1 is nan"),
+    "random-negative-radius": (lambda: random_sequential([0.01, -0.01]), "entry 1 is -0.01"),
+    "maxwellian-negative-temperature": (lambda: maxwellian(np.ones(4), -1.0),
+                                        "maxwellian(temperature=-1.0)"),
+    "maxwellian-zero-mass": (lambda: maxwellian([1.0, 0.0], 1.0), "entry 1 is 0.0"),
+    "packing-above-one": (lambda: radius_for_packing(10, 2.0),
+                          "radius_for_packing(packing_fraction=2.0)"),
+    "packing-complex": (lambda: radius_for_packing(10, 0.5j), "packing_fraction=0.5j"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_ARGUMENTS))
+def test_placement_helpers_refuse_bad_arguments_naming_them(case):
+    call, words = BAD_ARGUMENTS[case]
+    with pytest.raises(ValueError) as refusal:
+        call()
+    assert words in str(refusal.value) and "\n" not in str(refusal.value)

@@ -75,7 +75,11 @@ def restitution_matrix(restitution, n_species):
     dropped), else a symmetric float64[s, s] with entries in [0, 1]."""
     if restitution is None:
         return None
-    xi = np.broadcast_to(np.asarray(restitution, dtype=np.float64), (n_species, n_species))
+    xi = np.asarray(restitution, dtype=np.float64)
+    if xi.ndim != 0 and xi.shape != (n_species, n_species):
+        raise ValueError(f"restitution must be one number or a {n_species} × {n_species} "
+                         f"matrix (a row and a column per species), got shape {xi.shape}")
+    xi = np.broadcast_to(xi, (n_species, n_species))
     if not np.all((xi >= 0.0) & (xi <= 1.0)):
         raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
     if not np.array_equal(xi, xi.T):

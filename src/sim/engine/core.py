@@ -25,6 +25,8 @@ from sim.engine.inputs import (
     check_disks,
     check_inside,
     check_scales,
+    real_input,
+    species_input,
 )
 from sim.engine.kinematics import DISK_COLUMNS, RADIUS, VX, VY, X, Y
 from sim.engine.neighbours import build_all_neighbours, grow_lists, list_starts
@@ -76,16 +78,14 @@ class Engine(Running, Observables, Checkpoints):
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
                  boundary=Boundary(), *, shell=None, list_capacity=None, shell_lead=None,
                  **effects):
-        position = np.array(position, dtype=np.float64, order="C")
-        velocity = np.array(velocity, dtype=np.float64, order="C")
-        n = position.shape[0]
+        position, velocity = real_input("position", position), real_input("velocity", velocity)
+        n = position.shape[0] if position.ndim else 0
         if position.shape != (n, 2) or velocity.shape != (n, 2) or n == 0:
             raise ValueError(f"position and velocity must both be (n, 2) with n ≥ 1; got "
                              f"{position.shape} and {velocity.shape}")
-        radius = np.array(np.broadcast_to(np.asarray(radius, np.float64), (n,)))
-        mass = np.array(np.broadcast_to(np.asarray(mass, np.float64), (n,)))
-        species = (np.zeros(n, np.int32) if species is None
-                   else np.array(np.broadcast_to(np.asarray(species), (n,)), dtype=np.int32))
+        radius = np.array(np.broadcast_to(real_input("radius", radius), (n,)))
+        mass = np.array(np.broadcast_to(real_input("mass", mass), (n,)))
+        species = np.zeros(n, np.int32) if species is None else species_input(species, n)
         check_disks(position, velocity, radius, mass, species)
         box = box_size(boundary)
         periodic = np.array(boundary.periodic, dtype=bool)

@@ -3,6 +3,7 @@ checked before anything is built; a bad one is a ValueError whose one line names
 is allowed."""
 
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -136,3 +137,114 @@ def check_scales(box, radius, mass, velocity, extent, gravity, motion, temperatu
                          f"far edge of the disks ({extent:.3g}; the largest x + R or y + R, the "
                          f"side of a periodic axis): float64 coordinates there cannot resolve "
                          f"its contacts; radii must be at least {RESOLUTION_LIMIT * extent:.3g}")
+
+
+#: Largest count of collisions, contacts or events a run may be asked for (and the largest
+#: chunk): int64 counters, with room to add a chunk.
+MAX_COUNT = 2**62
+
+
+def refused(call, name, value, allowed):
+    """The ValueError of an argument ``name`` of the function ``call``: one line naming it,
+    its value (… for an array) and what is allowed."""
+    shown = "…" if isinstance(value, list | tuple | np.ndarray) else repr(value)
+    return ValueError(f"{call}({name}={shown}) is not allowed: {allowed}")
+
+
+def real_input(name, value):
+    """The argument ``name`` of the Engine as a C-ordered float64 array; a ValueError naming
+    it for complex numbers, text, or lists of unequal lengths."""
+    try:
+        kind = np.asarray(value).dtype.kind
+    except ValueError:  # ragged
+        kind = "O"
+    if kind not in "iuf":
+        raise refused("Engine", name, value, "real numbers")
+    return np.array(value, dtype=np.float64, order="C")
+
+
+def species_input(species, n):
+    """Species numbers int32[n] (one number for every disk, or one per disk); a ValueError
+    for what is not whole numbers from 0 to 2^31 − 1."""
+    numbers = np.broadcast_to(real_input("species", species), (n,))
+    if not np.all((numbers >= 0) & (numbers < 2**31) & (numbers == np.floor(numbers))):
+        raise refused("Engine", "species", species, "whole numbers from 0 to 2^31 - 1")
+    return numbers.astype(np.int32)
+
+
+def whole_count(call, name, value, low=0, high=MAX_COUNT):
+    """``value`` (an integer, or a float that is one, such as 1e6) as an int in [low, high];
+    a ValueError naming ``name`` of ``call`` otherwise."""
+    allowed = f"a whole number from {low} to {high if high < MAX_COUNT else '2^62'}"
+    if isinstance(value, bool | np.bool_):
+        raise refused(call, name, value, allowed)
+    try:
+        number = operator.index(value)
+    except TypeError:
+        if not (isinstance(value, float | np.floating) and math.isfinite(value)
+                and value == math.floor(value)):
+            raise refused(call, name, value, allowed) from None
+        number = int(value)
+    if not low <= number <= high:
+        raise refused(call, name, value, allowed)
+    return number
+
+
+def real_number(call, name, value, accept, allowed):
+    """``value`` as a float that ``accept`` takes; a ValueError naming ``name`` of ``call``
+    otherwise (complex numbers, text and booleans included)."""
+    if isinstance(value, bool | np.bool_ | complex | np.complexfloating | str):
+        raise refused(call, name, value, allowed)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise refused(call, name, value, allowed) from None
+    if not accept(number):
+        raise refused(call, name, value, allowed)
+    return number
+
+
+def real_array(call, name, value, accept, allowed):
+    """``value`` as a float64 array whose every entry ``accept`` takes (elementwise, on the
+    array); a ValueError naming ``name`` of ``call`` and the first entry at fault otherwise."""
+    if np.iscomplexobj(value):
+        raise refused(call, name, value, "real numbers: " + allowed)
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise refused(call, name, value, allowed) from None
+    bad = first_index(~accept(array).ravel())
+    if bad is not None:
+        raise ValueError(f"{call}({name}=…) is not allowed: entry {bad} is "
+                         f"{float(array.ravel()[bad])!r}; {allowed}")
+    return array
+
+
+def check_stop(contacts, collisions, events, time, energy_fraction, wall_seconds, until,
+               chunk_events):
+    """The arguments of :meth:`sim.engine.Engine.run`, checked as the command line checks its
+    ``stop`` keys: counts whole from 0 to 2^62 (targets since the engine started), ``time``
+    finite and ≥ 0 (absolute), ``energy_fraction`` in [0, 1], ``wall_seconds`` finite and
+    ≥ 0 (0: spent), ``until`` callable, ``chunk_events`` whole from 1; at least one stop condition.
+    Returns them with the counts as ints and the numbers as floats (None kept)."""
+    if all(x is None for x in (contacts, collisions, events, time, energy_fraction,
+                               wall_seconds, until)):
+        raise ValueError("run() needs at least one stop condition: contacts, collisions, "
+                         "events, time, energy_fraction, wall_seconds or until")
+    counts = [None if value is None else whole_count("run", name, value) for name, value in
+              (("contacts", contacts), ("collisions", collisions), ("events", events))]
+    if time is not None:
+        time = real_number("run", "time", time, lambda t: 0.0 <= t < math.inf,
+                           "a finite time ≥ 0 (the absolute time to stop at)")
+    if energy_fraction is not None:
+        energy_fraction = real_number("run", "energy_fraction", energy_fraction,
+                                      lambda f: 0.0 <= f <= 1.0,
+                                      "a fraction of the initial kinetic energy in [0, 1]")
+    if wall_seconds is not None:
+        wall_seconds = real_number("run", "wall_seconds", wall_seconds,
+                                   lambda w: 0.0 <= w < math.inf,
+                                   "a finite number of seconds ≥ 0")
+    if until is not None and not callable(until):
+        raise refused("run", "until", until, "a function of the engine returning True to stop")
+    return (*counts, time, energy_fraction, wall_seconds, until,
+            whole_count("run", "chunk_events", chunk_events, low=1))

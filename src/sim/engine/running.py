@@ -12,6 +12,7 @@ from sim.engine import codes, loop
 from sim.engine.compilation import compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
 from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
+from sim.engine.inputs import check_stop
 from sim.engine.kinematics import VX, VY, X, Y
 
 #: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
@@ -96,26 +97,25 @@ class Running:
         The piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended
         it. Chunk sizes change no result: the same inputs give the same bits.
         """
-        if all(x is None for x in (contacts, collisions, events, time, energy_fraction,
-                                   wall_seconds, until)):
-            raise ValueError("run() needs at least one stop condition")
+        (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
+         chunk_events) = check_stop(contacts, collisions, events, time, energy_fraction,
+                                    wall_seconds, until, chunk_events)
         big = np.iinfo(np.int64).max
-        max_contacts = big if contacts is None else int(contacts)
-        max_events = big if events is None else int(events)
-        max_collisions = big if collisions is None else int(collisions)
-        t_stop = math.inf if time is None else float(time)
+        max_contacts = big if contacts is None else contacts
+        max_events = big if events is None else events
+        max_collisions = big if collisions is None else collisions
+        t_stop = math.inf if time is None else time
         closing = t_stop > self.closing_time
         t_stop = min(t_stop, self.closing_time)
         dissipation_limit = (math.inf if energy_fraction is None
-                             else self.initial_energy * (1.0 - float(energy_fraction)))
+                             else self.initial_energy * (1.0 - energy_fraction))
         started = wallclock.perf_counter()
         reasons = {codes.STATUS_COLLISION_LIMIT: "collisions",
                    codes.STATUS_CONTACT_LIMIT: "contacts", codes.STATUS_TIME_REACHED: "time",
                    codes.STATUS_ENERGY_REACHED: "energy_fraction",
                    codes.STATUS_NO_EVENTS: "no_events"}
-        chunk = int(chunk_events) if wall_seconds is None else min(int(chunk_events),
-                                                                   TIMED_FIRST_CHUNK)
-        ask_at = self.events + int(chunk_events)  # where ``until`` is asked next
+        chunk = chunk_events if wall_seconds is None else min(chunk_events, TIMED_FIRST_CHUNK)
+        ask_at = self.events + chunk_events  # where ``until`` is asked next
         while True:
             chunk_started = wallclock.perf_counter()
             done = self.events
@@ -138,7 +138,7 @@ class Running:
                 rate = (self.events - done) / max(now - chunk_started, 1e-6)
                 chunk = int(np.clip(rate * TIMED_CHUNK_SECONDS, TIMED_MIN_CHUNK, chunk_events))
             if self.events >= ask_at:
-                ask_at += int(chunk_events)
+                ask_at += chunk_events
                 if until is not None and until(self):
                     return "predicate"
 

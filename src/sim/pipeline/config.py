@@ -17,11 +17,11 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import DictConfig, OmegaConf
 
 from sim.effects import check_config
+from sim.engine.inputs import MAX_COUNT
 from sim.pipeline.config_reference import leaves
 from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.input_checks import (
     LARGEST,
-    MAX_COUNT,
     MAX_DISKS,
     MAX_SEED,
     SMALLEST,

@@ -20,7 +20,21 @@ import math
 import numpy as np
 from numba import njit
 
+from sim.engine.inputs import real_array, real_number, whole_count
+from sim.pipeline.input_checks import MAX_DISKS
+
 RSA_JAMMING = 0.547
+
+
+def _count(call, n):
+    """The number of disks ``n`` of ``call``, whole and in [1, MAX_DISKS]."""
+    return whole_count(call, "n", n, low=1, high=MAX_DISKS)
+
+
+def _radii(call, radius):
+    """The radii of ``call`` (a number or an array), each finite and > 0."""
+    return real_array(call, "radius", radius, lambda r: (r > 0.0) & (r < math.inf),
+                      "radii finite and > 0")
 
 
 class PlacementError(ValueError):
@@ -99,6 +113,11 @@ def _rsa(radius, lo, hi, box, periodic, rng, max_attempts):
 
 def radius_for_packing(n, packing_fraction, area=1.0):
     """Radius of n equal disks that cover ``packing_fraction`` of ``area``: φ = n π R²/A."""
+    n = _count("radius_for_packing", n)
+    packing_fraction = real_number("radius_for_packing", "packing_fraction", packing_fraction,
+                                   lambda phi: 0.0 < phi < 1.0, "a packing fraction in (0, 1)")
+    area = real_number("radius_for_packing", "area", area, lambda a: 0.0 < a < math.inf,
+                       "a finite area > 0")
     return float(np.sqrt(packing_fraction * area / (n * np.pi)))
 
 
@@ -115,7 +134,7 @@ def random_sequential(radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
 
     Raises :class:`PlacementError` with the packing reached when a disk finds no room.
     """
-    radius = np.asarray(radius, dtype=np.float64)
+    radius = np.atleast_1d(_radii("random_sequential", radius))
     lo, hi = _region(region, box)
     periodic_region = np.array([periodic[a] and lo[a] == 0.0 and hi[a] == box[a]
                                 for a in range(2)])
@@ -145,7 +164,10 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
     rows along y); along walls the outermost centres stay a radius from the wall.
     ``radius`` may be an array; the lattice is spaced for the largest disk.
     """
-    r_max = float(np.max(radius))
+    n = _count("hexagonal_lattice", n)
+    r_max = float(np.max(_radii("hexagonal_lattice", radius)))
+    real_number("hexagonal_lattice", "jitter", jitter, lambda j: 0.0 <= j <= 1.0,
+                "a fraction of half the gap in [0, 1]")
     lo, hi = _region(region, box)
     wraps = [bool(periodic[a]) and lo[a] == 0.0 and hi[a] == box[a] for a in range(2)]
     width, height = (hi - lo) - np.where(wraps, 0.0, 2.0 * r_max)
@@ -236,13 +258,19 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
 
 def fixed_speed(n, speed, seed=0):
     """Velocities of equal magnitude ``speed`` in uniformly random directions: float64[n, 2]."""
+    n = _count("fixed_speed", n)
+    speed = real_number("fixed_speed", "speed", speed, lambda v: 0.0 <= v < math.inf,
+                        "a finite speed ≥ 0")
     angle = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi, n)
     return speed * np.stack([np.cos(angle), np.sin(angle)], axis=1)
 
 
 def maxwellian(mass, temperature, seed=0):
     """Velocities with components drawn from N(0, T/m) (k_B = 1): float64[n, 2]."""
-    mass = np.asarray(mass, dtype=np.float64)
+    mass = np.atleast_1d(real_array("maxwellian", "mass", mass,
+                                    lambda m: (m > 0.0) & (m < math.inf), "masses finite and > 0"))
+    temperature = real_number("maxwellian", "temperature", temperature,
+                              lambda t: 0.0 <= t < math.inf, "a finite temperature ≥ 0")
     scale = np.sqrt(temperature / mass)
     return np.random.default_rng(seed).normal(size=(mass.size, 2)) * scale[:, None]
 

@@ -22,8 +22,6 @@ SMALLEST_RADIUS = RESOLUTION_LIMIT
 MAX_SEED = 2**63 - 1
 #: Largest number of disks: the engine numbers them with int32.
 MAX_DISKS = 2**31 - 1
-#: Largest collision or contact count: int64 counters, with room to add a chunk.
-MAX_COUNT = 2**62
 
 
 class ConfigError(ValueError):
