@@ -258,6 +258,9 @@ BAD_INPUT = {
     "seed--1": ("seed=-1", "seed"),
     "seed-1e23": ("seed=100000000000000000000000", "seed"),
     "seed-1.5": ("seed=1.5", "seed"),
+    # keys the schema does not have, added with + or ++
+    "plus-unknown-key": ("+disks.extra=5", "disks.extra"),
+    "plusplus-unknown-key": ("++foo=5", "foo"),
     # scenes
     "two_disks-n-5": ("scenario=two_disks disks.n=5", "disks.n"),
     "mixture-empty-species": ("scenario=mixture disks.n=3 mixture.masses=[1,2,3,4,5] "

@@ -95,9 +95,22 @@ def _check_numbers(c):
         raise ConfigError("seed", c.seed, f"an integer from 0 to 2^63 − 1 = {MAX_SEED}")
 
 
+def _check_keys(c):
+    """Refuse a key the schema does not have (Hydra lets ``+key=`` and ``++key=`` add one):
+    every leaf is a key of the schema, a section of it left out (``projectile: null``), or
+    lies under a key whose value is a mapping (walls)."""
+    known = [key for key, _ in leaf_fields()]
+    for key in flat(c):
+        if key not in known and not any(key.startswith(k + ".") or k.startswith(key + ".")
+                                        for k in known):
+            raise ConfigError(key, OmegaConf.select(c, key), "a key of the config, as "
+                              "python -m sim --help lists them (+ and ++ add no new keys)")
+
+
 def validate(cfg: Any) -> None:
     """Check every value of a composed config; raise :class:`ConfigError` on the first bad one."""
     c = cfg if isinstance(cfg, DictConfig) else OmegaConf.structured(cfg)
+    _check_keys(c)
     if c.scene not in SCENES:
         raise ConfigError("scene", c.scene, f"one of {', '.join(SCENES)}")
     scene = SCENES[c.scene]
