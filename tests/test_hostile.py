@@ -716,9 +716,16 @@ def test_the_same_sweep_again_changes_nothing_and_reads_back_labelled(swept):
     assert recorded == labels
 
 
-def test_a_sweep_into_the_default_sweep_folder_runs(tmp_path):
-    """The README's sweep command: no hydra.sweep.dir, ``-m`` last."""
-    result = sim(*SWEEP, "-m", cwd=tmp_path)
+def test_a_flag_hydra_refuses_leaves_no_run_folder(tmp_path):
+    result = sim("--no-such-flag", cwd=tmp_path, timeout=HANG_GUARD)
+    assert result.code == 2 and "--no-such-flag" in result.err
+    assert tree(tmp_path) == {}
+
+
+def test_a_sweep_into_the_default_sweep_folder_runs_with_the_flag_first(tmp_path):
+    """No hydra.sweep.dir, and the flag first as Hydra's documents write it (``-m`` last, as
+    the README writes it, in the sweeps above)."""
+    result = sim("--multirun", *SWEEP, cwd=tmp_path)
     check(result, 0)
     files = sorted(tmp_path.glob("outputs/multirun/*/*/*/run.h5"))
     assert len(files) == 2

@@ -53,7 +53,13 @@ from sim.pipeline.cli_exits import (
 )
 from sim.pipeline.config import ConfigError, register
 from sim.pipeline.interruption import Interruption
-from sim.pipeline.overrides import CONF_DIR, SWEEP_FLAGS, value_of, whole_numbers
+from sim.pipeline.overrides import (
+    CONF_DIR,
+    SWEEP_FLAGS,
+    sweep_flag_last,
+    value_of,
+    whole_numbers,
+)
 from sim.pipeline.preflight import (
     check_command_line,
     check_resources,
@@ -146,8 +152,13 @@ def main():
         check_resources(args, configs)
         if sweeping and value_of(args, "hydra.sweep.dir") is not None:
             check_sweep_folder(args, configs)
-        sys.argv[1:] = args
-        hydra_main()
+        sys.argv[1:] = sweep_flag_last(args)
+        try:
+            hydra_main()
+        except SystemExit as stop:
+            if stop.code not in (0, None):
+                remove_made_folders()  # those still empty: a refusal leaves none behind
+            raise
     except KeyboardInterrupt:
         remove_made_folders()
         if sweeping:

@@ -96,6 +96,13 @@ def _quoted(text):
     return "'" + text.replace("'", "\\'") + "'"
 
 
+def sweep_flag_last(args):
+    """The command line with its sweep flag (-m, --multirun) last: Hydra's parser takes the
+    overrides as one run of words, which a flag between them would cut (``-m seed=0,1`` once a
+    folder override is put first)."""
+    return [*(a for a in args if a not in SWEEP_FLAGS), *(a for a in args if a in SWEEP_FLAGS)]
+
+
 def with_value(args, key, value):
     """The command line with ``key=value`` in place of what it gave ``key``, first (Hydra
     takes overrides before its flags, such as -m)."""
