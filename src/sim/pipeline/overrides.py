@@ -49,7 +49,7 @@ def combinations(args):
     try:
         parsed = OverridesParser.create().parse_overrides(overrides)
     except Exception as error:
-        fail(first_line(error))
+        fail(_unreadable(overrides, error))
     choices = OrderedDict()
     for o in parsed:
         key = o.get_key_element()
@@ -58,6 +58,23 @@ def combinations(args):
         else:
             choices[key] = [f"{key}={o.get_value_element_as_str()}"]
     return [list(c) for c in itertools.product(*choices.values())]
+
+
+def _unreadable(overrides, error):
+    """The first of ``overrides`` that Hydra's grammar cannot read, in one line naming its key
+    (a long value cut short), and why."""
+    parser = OverridesParser.create()
+    for override in overrides:
+        try:
+            parser.parse_override(override)
+        except Exception as failure:
+            key, _, value = override.partition("=")
+            shown = value if len(value) <= 40 else f"{value[:20]}… ({len(value)} characters)"
+            reason = str(failure).strip().splitlines()[0] if str(failure).strip() else ""
+            if "Exceeds the limit" in reason:  # Python's cap on the digits of an int
+                reason = f"a number, not one of {len(value)} digits"
+            return f"{key}={shown} is not allowed: {reason or first_line(failure)}"
+    return first_line(error)
 
 
 def compose_overrides(combination, hydra_config=False):
