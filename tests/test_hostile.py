@@ -525,6 +525,15 @@ def test_resume_of_a_run_file_whose_config_was_edited_is_refused(extra, small_ru
     assert tree(tmp_path) == before  # nothing changed, nothing new
 
 
+def test_resume_into_another_run_folder_is_refused(entry, small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = entry(f"resume={good}", f"hydra.run.dir={tmp_path / 'X'}")
+    check(result, 2, ["hydra.run.dir", "resume"], before, tree(tmp_path), nothing_new=True)
+    result = entry(f"resume={good}", f"hydra.run.dir={good.parent}")  # its own folder
+    assert result.code == "not refused before Hydra started"
+
+
 def test_resume_may_not_change_the_scene(entry, small_run, tmp_path):
     good = copy_run(small_run, tmp_path)
     before = tree(tmp_path)

@@ -129,8 +129,13 @@ def run_folder(args):
     sweeping = any(a in SWEEP_FLAGS for a in args)
     key = "hydra.sweep.dir" if sweeping else "hydra.run.dir"
     resume = value_of(args, "resume")
-    if not sweeping and resume is not None and value_of(args, key) is None:
-        return with_value(args, key, Path(resume).parent)  # no new folder for a resume
+    if not sweeping and resume is not None:  # no new folder for a resume
+        home, named = Path(resume).parent, value_of(args, key)
+        if named is not None and Path(named).resolve() != home.resolve():
+            fail(str(ConfigError(key, named, f"left out, or the folder of the run file it "
+                                             f"resumes ({home}): a resume continues the file "
+                                             f"where it is")))
+        return with_value(args, key, home)
     # the folder as Hydra would make it, interpolations such as ${now:…} resolved once here
     given = Path(OmegaConf.select(hydra_settings(args), key))
     if value_of(args, key) is not None:
