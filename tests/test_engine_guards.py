@@ -114,6 +114,12 @@ def test_bad_values_are_refused_naming_the_disk_or_parameter():
     p[3] = [0.01, 0.5]
     refused(r"disk 3 at \[0\.01, 0\.5\] with radius 0\.02 pokes through a wall", p, velocity,
             0.02)
+    # a disk as wide as the box touches both walls for ever
+    refused(r"disk 0 of radius 0\.5 does not fit between the walls 1 apart along x",
+            [[0.5, 0.5]], [[0.0, 0.0]], 0.5)
+    refused(r"disk 1 of radius 0\.3 does not fit between the walls 0\.5 apart along y",
+            [[0.5, 0.25], [0.4, 0.25]], [[0.0, 0.0]] * 2, [0.01, 0.3],
+            boundary=Boundary(size=(1.0, 0.5)))
     for size in ((1.0, np.nan), (0.0, 1.0), (1.0, np.inf)):
         refused("box size must be two finite sides > 0", position, velocity, 0.02,
                 boundary=Boundary(size=size))

@@ -58,10 +58,18 @@ def box_size(boundary):
 
 
 def check_inside(given, position, radius, box, periodic):
-    """Refuse a disk reaching beyond a wall (R ≤ x ≤ L − R on a walled axis), naming the
-    first; ``given`` are the positions as the caller gave them, ``position`` wrapped."""
+    """Refuse a disk as wide as the box or wider (2R < L on a walled axis: a disk touching
+    both walls at once would touch them for ever), or reaching beyond a wall (R ≤ x ≤ L − R),
+    naming the first; ``given`` are the positions as the caller gave them, ``position``
+    wrapped."""
     for axis in range(2):
         if not periodic[axis]:
+            too_wide = first_index(2.0 * radius >= box[axis])
+            if too_wide is not None:
+                raise ValueError(f"disk {too_wide} of radius {radius[too_wide]:g} does not fit "
+                                 f"between the walls {box[axis]:g} apart along "
+                                 f"{'xy'[axis]}: a disk's diameter must be less than the "
+                                 f"box side")
             bad = first_index((position[:, axis] - radius < 0.0)
                          | (position[:, axis] + radius > box[axis]))
             if bad is not None:
