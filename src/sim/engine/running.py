@@ -94,8 +94,12 @@ class Running:
             stop at the same event
         chunk_events : events per compiled call (the most, with ``wall_seconds``)
 
-        The piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended
-        it. Chunk sizes change no result: the same inputs give the same bits.
+        Counts are whole numbers from 0 to 2^62, ``time`` finite and ≥ 0, ``energy_fraction``
+        in [0, 1], ``wall_seconds`` finite and ≥ 0, ``chunk_events`` whole and ≥ 1: anything
+        else is a ValueError naming the argument, before any event
+        (:func:`sim.engine.inputs.check_stop`). The piston-jam guard (:meth:`_check_piston`)
+        runs after every chunk, whatever ended it. Chunk sizes change no result: the same
+        inputs give the same bits.
         """
         (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
          chunk_events) = check_stop(contacts, collisions, events, time, energy_fraction,
