@@ -300,3 +300,18 @@ def test_the_cluster_launcher_config_composes_to_slurm():
     launcher = cfg.hydra.launcher
     assert launcher._target_.endswith("SlurmLauncher")
     assert (launcher.cpus_per_task, launcher.array_parallelism) == (1, 200)
+
+
+def test_the_wall_budget_does_not_count_compiling_the_loop(tmp_path, monkeypatch):
+    """A budget of a microsecond, as if compiling the loop had taken 10⁶ s more: the
+    compilation is not counted, and the run ends by its other stop condition."""
+    from sim.engine import running
+
+    real = running.compile_once
+    monkeypatch.setattr(running, "compile_once", lambda function, arguments:
+                        real(function, arguments) + 1e6)
+    cfg = compose_scene("gas", "stop.collisions=3000", "stop.wall_seconds=1e-6")
+    assert summary(runner.run(cfg, tmp_path))["stop_reason"] == "collisions"
+    monkeypatch.setattr(running, "compile_once", real)
+    (tmp_path / "counted").mkdir()  # the same budget without the credit is spent at once
+    assert summary(runner.run(cfg, tmp_path / "counted"))["stop_reason"] == "wall_seconds"

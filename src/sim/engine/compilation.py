@@ -18,6 +18,7 @@ Both locks are ``flock(2)`` locks, released by the system when their process end
 import contextlib
 import fcntl
 import os
+import time
 import zlib
 
 from numba.core import caching
@@ -42,16 +43,19 @@ def _held(path):
 def compile_once(function, arguments):
     """Compile, or load from the cache, the variant of the compiled ``function`` that
     ``arguments`` (a tuple) call, holding the lock of that variant, unless this process holds
-    it already. Typing the arguments takes about 0.3 ms: call it once per engine and list
-    layout, not per call."""
+    it already; returns the wall-clock seconds it took (waiting included; 0 when held).
+    Typing the arguments takes about 0.3 ms: call it once per engine and list layout, not
+    per call."""
     if not hasattr(function, "overloads"):
-        return  # NUMBA_DISABLE_JIT: plain Python, nothing to compile
+        return 0.0  # NUMBA_DISABLE_JIT: plain Python, nothing to compile
     signature = tuple(function.typeof_pyval(a) for a in arguments)
     if signature in function.overloads:
-        return
+        return 0.0
+    started = time.perf_counter()
     name = f"{function.__name__}-{zlib.crc32(str(signature).encode()):08x}.lock"
     with _held(os.path.join(os.environ["NUMBA_CACHE_DIR"], name)):
         function.compile(signature)
+    return time.perf_counter() - started
 
 
 def _saved_under_lock(save):

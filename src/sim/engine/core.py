@@ -138,6 +138,8 @@ class Engine(Running, Observables, Checkpoints):
                                        self.wall_motion, self.wall_temperature)
         self.stall_watch = np.array([-math.inf, 0.0])
         self._compiled_layout = None  # the list layout whose loop variant compile_once made
+        #: wall-clock seconds this engine spent compiling (or loading) its event loop
+        self.compile_seconds = 0.0
         self._build(position, velocity, shell, shell_lead, list_capacity, disk_effects,
                     first_event_time(box, velocity, self.gravity, self.wall_motion))
         self.initial_energy += self.rotational_energy()

@@ -50,9 +50,10 @@ def next_snapshot_time(last_time, every_time):
 
 def advance(engine, cfg, writer, last_time, started, interruption):
     """Run from snapshot to snapshot (the last one at ``last_time``) until a stop condition
-    holds, the wall-clock budget (counted from ``started``, a ``time.perf_counter()``) is
-    spent, or SIGINT or SIGTERM arrives (``interruption``, an entered
-    :class:`sim.pipeline.interruption.Interruption`); returns the stop reason."""
+    holds, the wall-clock budget (counted from ``started``, a ``time.perf_counter()``, the
+    engine's compilation of its loop not counted) is spent, or SIGINT or SIGTERM arrives
+    (``interruption``, an entered :class:`sim.pipeline.interruption.Interruption`); returns
+    the stop reason."""
     stop, out = cfg.stop, cfg.output
     resting = None if stop.at_rest is None else at_rest(stop.at_rest)
     cadence = every_collisions(cfg, engine.n)
@@ -60,10 +61,11 @@ def advance(engine, cfg, writer, last_time, started, interruption):
     def until(engine):
         return interruption.requested or (resting is not None and resting(engine))
 
-    def budget():
+    def budget():  # the compilation of the event loop is not counted
         if stop.wall_seconds is None:
             return None
-        return max(stop.wall_seconds - (wallclock.perf_counter() - started), 0.0)
+        spent = wallclock.perf_counter() - started - engine.compile_seconds
+        return max(stop.wall_seconds - spent, 0.0)
 
     bar = _progress(cfg, engine)
     try:
