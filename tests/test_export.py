@@ -148,6 +148,15 @@ def test_only_the_frames_asked_for_are_written(mixture, tmp_path):
         assert [int(keys["Step"]) for keys, _ in read_xyz(xyz_file)] == list(steps[-2:])
 
 
+def test_both_formats_are_made_as_every_file_is(mixture, tmp_path):
+    """The umask decides the permissions (gsd alone makes its files 0640)."""
+    made = tmp_path / "plain"
+    made.touch()
+    for fmt in ("gsd", "xyz"):
+        written = export(mixture, fmt, tmp_path / f"x.{fmt}")
+        assert written.stat().st_mode == made.stat().st_mode, fmt
+
+
 def test_the_default_output_is_beside_the_run_file(mixture, tmp_path):
     path = tmp_path / "mine.h5"
     shutil.copy(mixture, path)

@@ -183,6 +183,7 @@ def export(run_path, fmt, out=None, frames=None):
             raise BadInput(f"--out {target} is the run file itself")
         partial = target.with_name(f".{target.name}.{os.getpid()}.part")
         try:
+            partial.touch()  # made as every file is (the umask); gsd alone would make it 0640
             WRITERS[fmt](partial, run, snapshots(run, indices))
             os.replace(partial, target)
         except OSError as error:
