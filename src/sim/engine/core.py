@@ -25,7 +25,7 @@ from sim.engine.inputs import (
     check_disks,
     check_inside,
     check_scales,
-    real_input,
+    real_array,
     species_input,
 )
 from sim.engine.kinematics import DISK_COLUMNS, RADIUS, VX, VY, X, Y
@@ -78,13 +78,14 @@ class Engine(Running, Observables, Checkpoints):
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
                  boundary=Boundary(), *, shell=None, list_capacity=None, shell_lead=None,
                  **effects):
-        position, velocity = real_input("position", position), real_input("velocity", velocity)
+        position = real_array("Engine", "position", position)
+        velocity = real_array("Engine", "velocity", velocity)
         n = position.shape[0] if position.ndim else 0
         if position.shape != (n, 2) or velocity.shape != (n, 2) or n == 0:
             raise ValueError(f"position and velocity must both be (n, 2) with n ≥ 1; got "
                              f"{position.shape} and {velocity.shape}")
-        radius = np.array(np.broadcast_to(real_input("radius", radius), (n,)))
-        mass = np.array(np.broadcast_to(real_input("mass", mass), (n,)))
+        radius = np.array(np.broadcast_to(real_array("Engine", "radius", radius), (n,)))
+        mass = np.array(np.broadcast_to(real_array("Engine", "mass", mass), (n,)))
         species = np.zeros(n, np.int32) if species is None else species_input(species, n)
         check_disks(position, velocity, radius, mass, species)
         box = box_size(boundary)

@@ -159,22 +159,10 @@ def refused(call, name, value, allowed):
     return ValueError(f"{call}({name}={shown}) is not allowed: {allowed}")
 
 
-def real_input(name, value):
-    """The argument ``name`` of the Engine as a C-ordered float64 array; a ValueError naming
-    it for complex numbers, text, or lists of unequal lengths."""
-    try:
-        kind = np.asarray(value).dtype.kind
-    except ValueError:  # ragged
-        kind = "O"
-    if kind not in "iuf":
-        raise refused("Engine", name, value, "real numbers")
-    return np.array(value, dtype=np.float64, order="C")
-
-
 def species_input(species, n):
     """Species numbers int32[n] (one number for every disk, or one per disk); a ValueError
     for what is not whole numbers from 0 to 2^31 − 1."""
-    numbers = np.broadcast_to(real_input("species", species), (n,))
+    numbers = np.broadcast_to(real_array("Engine", "species", species), (n,))
     if not np.all((numbers >= 0) & (numbers < 2**31) & (numbers == np.floor(numbers))):
         raise refused("Engine", "species", species, "whole numbers from 0 to 2^31 - 1")
     return numbers.astype(np.int32)
@@ -212,16 +200,19 @@ def real_number(call, name, value, accept, allowed):
     return number
 
 
-def real_array(call, name, value, accept, allowed):
-    """``value`` as a float64 array whose every entry ``accept`` takes (elementwise, on the
-    array); a ValueError naming ``name`` of ``call`` and the first entry at fault otherwise."""
-    if np.iscomplexobj(value):
-        raise refused(call, name, value, "real numbers: " + allowed)
+def real_array(call, name, value, accept=None, allowed=""):
+    """``value`` as a C-ordered float64 array; a ValueError naming ``name`` of ``call`` for what
+    is not real numbers (complex numbers, text, lists of unequal lengths) and, with ``accept``
+    (elementwise, on the array), for the first entry it refuses (``allowed`` says what may
+    be)."""
     try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise refused(call, name, value, allowed) from None
-    bad = first_index(~accept(array).ravel())
+        kind = np.asarray(value).dtype.kind
+    except ValueError:  # lists of unequal lengths
+        kind = "O"
+    if kind not in "iuf":
+        raise refused(call, name, value, "real numbers")
+    array = np.array(value, dtype=np.float64, order="C")
+    bad = None if accept is None else first_index(~np.ravel(accept(array)))
     if bad is not None:
         raise ValueError(f"{call}({name}=…) is not allowed: entry {bad} is "
                          f"{float(array.ravel()[bad])!r}; {allowed}")

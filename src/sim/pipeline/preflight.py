@@ -132,9 +132,8 @@ def run_folder(args):
     if not sweeping and resume is not None:  # no new folder for a resume
         home, named = Path(resume).parent, value_of(args, key)
         if named is not None and Path(named).resolve() != home.resolve():
-            fail(str(ConfigError(key, named, f"left out, or the folder of the run file it "
-                                             f"resumes ({home}): a resume continues the file "
-                                             f"where it is")))
+            fail(ConfigError(key, named, f"left out, or the folder of the run file it resumes "
+                                         f"({home}): a resume continues the file where it is"))
         return with_value(args, key, home)
     # the folder as Hydra would make it, interpolations such as ${now:…} resolved once here
     given = Path(OmegaConf.select(hydra_settings(args), key))
