@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import h5py
 import numpy as np
@@ -63,7 +64,14 @@ def test_a_run_killed_at_any_moment_opens_and_resumes_to_the_same_bits(
     path = tmp_path / "run.h5"
     info = summary(path)  # opens, with every frame flushed before the kill
     assert info["stop_reason"] == "running"
-    runner.resume(path)
+    with h5py.File(path, "r") as f:  # frames flushed after the last checkpoint
+        root = f["checkpoint"]
+        dropped = info["snapshots"] - root[root.attrs["latest"]].attrs["snapshots"]
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        runner.resume(path)
+    assert [str(w.message).split("; ")[1].split(",")[0] for w in said] == (
+        [f"the {dropped} snapshots written after it"] if dropped else [])
     steps, positions, reason = frames(path)
     whole_steps, whole_positions, _ = frames(uninterrupted)
     assert reason == "collisions"

@@ -325,6 +325,13 @@ BAD_INPUT = {
                              "restitution.wall_tangential"),
     "rough-pressure-tensor": ("restitution.tangential=0.5 observe.pressure_tensor=true",
                               "observe.pressure_tensor"),
+    # flags Hydra's parser refuses, in one line instead of its usage text
+    "flag-unknown": ("--no-such-flag", "--no-such-flag"),
+    "flag-short-unknown": ("-x disks.n=10", "-x"),
+    "flag-abbreviated": ("--multi seed=0,1", "--multi"),
+    "flag-without-its-value": ("--cfg", "--cfg"),
+    "flag-value-not-a-choice": ("--cfg=everything", "--cfg"),
+    "flags-that-exclude-each-other": ("--cfg job seed=0,1 -m", "--cfg"),
 }
 
 
@@ -338,6 +345,15 @@ def test_bad_input_is_refused_with_one_line_and_nothing_written(case, entry, tmp
     before = tree(tmp_path)
     result = entry(*args)
     check(result, 2, [key], before, tree(tmp_path), nothing_new=True)
+
+
+@pytest.mark.parametrize("flags", ["--cfg job", "--info", "--hydra-help", "--cfg all seed=3"])
+def test_flags_that_only_print_make_no_run_folder(flags, entry, tmp_path):
+    """``--cfg job`` and the like reach Hydra, which prints and runs nothing: no folder is
+    made for a run."""
+    result = entry(*flags.split())
+    assert result.code == "not refused before Hydra started", result
+    assert tree(tmp_path) == {}
 
 
 def test_a_misspelt_key_is_quoted_with_the_value_given(entry, tmp_path):
@@ -461,6 +477,14 @@ def _edited_n(path):
         f["parameters"].attrs["config"] = yaml.safe_dump(config)
 
 
+def _no_checkpoint(path):
+    """A run file stripped of /checkpoint, as a killed run of an old version leaves it:
+    resuming it could only start it again over its snapshots."""
+    with h5py.File(path, "r+") as f:
+        del f["checkpoint"]
+        f["parameters"].attrs["stop_reason"] = "running"
+
+
 def _write(path, data):
     if isinstance(data, str):
         path.write_text(data)
@@ -485,11 +509,14 @@ BAD_RESUME = {
     "garbage-config": lambda folder, good: _then(_garbage_config, good),
 }
 
+#: run files that open but cannot be continued
+UNRESUMABLE = {"no-checkpoint": lambda folder, good: _then(_no_checkpoint, good)}
 
-@pytest.mark.parametrize("case", list(BAD_RESUME), ids=list(BAD_RESUME))
+
+@pytest.mark.parametrize("case", [*BAD_RESUME, *UNRESUMABLE])
 def test_resume_of_what_is_not_a_run_file_is_refused(case, entry, small_run, tmp_path):
     good = copy_run(small_run, tmp_path)
-    target = BAD_RESUME[case](tmp_path, good)
+    target = (BAD_RESUME | UNRESUMABLE)[case](tmp_path, good)
     before = tree(tmp_path)
     result = entry(f"resume={target}")
     check(result, 2, ["resume"], before, tree(tmp_path), nothing_new=True)
@@ -582,6 +609,43 @@ def test_resume_to_more_collisions_continues_a_complete_run(small_run, tmp_path)
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["prev", "run.h5"]  # no leftovers
 
 
+@pytest.mark.parametrize("key", ["seed", "scene"])
+def test_a_stored_config_is_read_as_data_never_resolved(key, entry, small_run, tmp_path,
+                                                        monkeypatch):
+    """An interpolation put into a stored config is not resolved on resume: the key holds
+    its text, which the schema refuses (an integer seed) or the file contradicts (a scene
+    that is no scene)."""
+    good = copy_run(small_run, tmp_path)
+    with h5py.File(good, "r+") as f:
+        config = yaml.safe_load(str(f["parameters"].attrs["config"]))
+        config[key] = "${oc.env:MY_VALUE}"
+        f["parameters"].attrs["config"] = yaml.safe_dump(config)
+    monkeypatch.setenv("MY_VALUE", {"seed": "7", "scene": "gas"}[key])
+    before = tree(tmp_path)
+    result = entry(f"resume={good}", "stop.collisions=4000")
+    check(result, 2, ["resume", "${oc.env:MY_VALUE}"], before, tree(tmp_path),
+          nothing_new=True)
+
+
+def test_resume_after_a_kill_says_which_snapshots_it_computes_again(small_run, tmp_path):
+    """A run killed between checkpoints: its file points at the first checkpoint while later
+    frames were flushed. Resume says how many it drops and ends with the frames of the run
+    never killed."""
+    good = copy_run(small_run, tmp_path)
+    with h5py.File(small_run, "r") as f:
+        whole = f["particles/disks/position/value"][()]
+    with h5py.File(good, "r+") as f:
+        first = min(f["checkpoint"], key=lambda slot: f["checkpoint"][slot].attrs["snapshots"])
+        f["checkpoint"].attrs["latest"] = first
+        f["parameters"].attrs["stop_reason"] = "running"
+    with pytest.warns(RuntimeWarning, match=rf"the {len(whole) - 1} snapshots written after "
+                                            rf"it, to t = .*, are dropped and computed again"):
+        runner.resume(good)
+    with h5py.File(good, "r") as f:
+        np.testing.assert_array_equal(f["particles/disks/position/value"][()], whole)
+    assert summary(good)["stop_reason"] == "collisions"
+
+
 # ---------------------------------------------------------------------------------------
 # folders and files, never lost
 
@@ -625,6 +689,104 @@ def test_resume_of_a_live_run_file_is_refused(live_run):
     check(result, 2, ["resume"])
     assert process.poll() is None, "the first run died"
     assert not set(tree(folder)) - before
+
+
+#: a process that holds a run file open for writing, as a resume does, until it is killed
+HOLDING = "import h5py, sys, time; f = h5py.File(sys.argv[1], 'r+'); print('open', flush=True); \
+time.sleep(600)"
+
+
+def _alias(path, how, folder):
+    """Another name of the run file ``path`` in ``folder``: a hard or a symbolic link."""
+    folder.mkdir()
+    alias = folder / "alias.h5"
+    if how == "hard link":
+        os.link(path, alias)
+    else:
+        alias.symlink_to(path)
+    return alias
+
+
+@pytest.mark.parametrize("how", ["hard link", "symbolic link"])
+def test_a_run_file_in_use_is_refused_under_every_name(how, small_run, tmp_path):
+    """Resumed under one name, a run file is refused under another: a symbolic link leads to
+    the same lock file, a hard link meets HDF5's lock of the file another process has open."""
+    from sim.pipeline.run_folder import RunLock
+
+    good = copy_run(small_run, tmp_path)
+    alias = _alias(good, how, tmp_path / "other")
+    for using, asked in ((good, alias), (alias, good)):
+        if how == "hard link":
+            holder = subprocess.Popen([PY, "-c", HOLDING, str(using)], stdout=subprocess.PIPE,
+                                      stderr=subprocess.PIPE, text=True)
+            assert holder.stdout.readline().strip() == "open", finish(holder)
+            try:
+                before = tree(tmp_path)
+                with pytest.raises(ConfigError, match="resume"):
+                    runner.resume(asked, ["stop.collisions=4000"])
+                assert tree(tmp_path) == before
+            finally:
+                holder.kill()
+                finish(holder)
+        else:
+            before = tree(tmp_path)
+            with RunLock(using), pytest.raises(ConfigError,
+                                               match="resume.*no other run is using"):
+                runner.resume(asked, ["stop.collisions=4000"])
+            assert tree(tmp_path) == before
+
+
+#: Resumes of a run file in use under another name, and of a new run's file through a hard
+#: link made while it runs, in a process where HDF5 does not lock files: one line per case
+WITHOUT_HDF5_LOCKS = """
+import os, sys
+from pathlib import Path
+from sim.pipeline import runner, writing
+from sim.pipeline.config import ConfigError
+from sim.pipeline.run_cache import compose_config
+from sim.pipeline.run_folder import HDF5_LOCKS_FILES, RunLock
+
+def refused(path):
+    try:
+        runner.resume(path, ["stop.collisions=4000"])
+        return "resumed"
+    except ConfigError as error:
+        return "refused" if "no other run is using" in str(error) else str(error)
+
+print("HDF5 locks files:", HDF5_LOCKS_FILES)
+good, hard, soft, fresh = map(Path, sys.argv[1:])
+for using, asked in ((good, hard), (hard, good), (good, soft), (soft, good)):
+    with RunLock(using):
+        print(using.name, asked.name, refused(asked))
+advance = writing.advance
+
+def resume_through_a_link(engine, cfg, writer, *args):
+    os.link(writer.path, fresh.parent / "alias.h5")
+    print("live run", refused(fresh.parent / "alias.h5"))
+    return advance(engine, cfg, writer, *args)
+
+writing.advance = resume_through_a_link
+runner.run(compose_config(["disks.n=200", "stop.collisions=2000"]), fresh)
+"""
+
+
+def test_without_hdf5_locks_a_run_file_is_still_refused_under_every_name(small_run, tmp_path):
+    """``HDF5_USE_FILE_LOCKING=FALSE`` (usual on Lustre and NFS) leaves the file to sim's own
+    lock of it: resumed, or written by a new run, under one name, refused under another."""
+    good = copy_run(small_run, tmp_path)
+    hard = _alias(good, "hard link", tmp_path / "h")
+    soft = _alias(good, "symbolic link", tmp_path / "s")
+    before = tree(tmp_path)
+    done = subprocess.run([PY, "-c", WITHOUT_HDF5_LOCKS, str(good), str(hard), str(soft),
+                           str(tmp_path / "fresh")], capture_output=True, text=True,
+                          timeout=HANG_GUARD, env={**os.environ, "HDF5_USE_FILE_LOCKING": "FALSE"})
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert done.stdout.splitlines() == [
+        "HDF5 locks files: False", "run.h5 alias.h5 refused", "alias.h5 run.h5 refused",
+        "run.h5 alias.h5 refused", "alias.h5 run.h5 refused", "live run refused"]
+    assert tree(tmp_path / "prev") == {k.partition("/")[2]: v for k, v in before.items()
+                                       if k.startswith("prev/") and k != "prev/"}
+    assert summary(tmp_path / "fresh" / "run.h5")["stop_reason"] == "collisions"
 
 
 def test_a_live_run_ends_on_sigint_with_its_file_whole(live_run):
@@ -868,6 +1030,41 @@ def test_sigterm_ends_a_run_resumably_and_resume_finishes_it(tmp_path):
     check(again, 0)
     assert stop_reason(path) == "collisions"
     assert not hidden_leftovers(tmp_path)
+
+
+def descendants(pid):
+    """The pids of every process under ``pid`` (from /proc)."""
+    parents = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rpartition(")")[2].split()
+        except OSError:  # ended meanwhile
+            continue
+        parents.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    found, todo = [], [pid]
+    while todo:
+        children = parents.get(todo.pop(), [])
+        found += children
+        todo += children
+    return found
+
+
+def test_a_sweep_whose_jobs_get_sigterm_exits_143(tmp_path):
+    """A scheduler that sends SIGTERM to the workers of a sweep, not to the command: each job
+    ends as terminated, and the command says so with status 143."""
+    process = start(*FOREVER, "seed=0,1", "hydra.sweep.dir=S", "-m", cwd=tmp_path)
+    try:
+        for job in ("0", "1"):
+            assert wait_for(tmp_path / "S" / job / "run.h5", process), finish(process).err
+    finally:
+        for pid in descendants(process.pid):
+            try:
+                os.kill(pid, signal.SIGTERM)
+            except ProcessLookupError:
+                pass
+        result = finish(process)
+    check(result, 143, ["terminated", "hydra.sweep.dir=S"])
+    assert {stop_reason(tmp_path / "S" / job / "run.h5") for job in "01"} == {"terminated"}
 
 
 #: ``python -m sim`` that sends itself SIGINT at a moment of its start-up, the first argument:

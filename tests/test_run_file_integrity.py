@@ -171,7 +171,8 @@ def test_resume_falls_back_to_the_older_checkpoint_when_the_latest_is_damaged(in
         written.append("b" if self.file["checkpoint"].attrs["latest"] == "a" else "a")
         original(self, engine, t)
 
-    with pytest.warns(RuntimeWarning, match=f"slot {slot} is damaged"):
+    with pytest.warns(RuntimeWarning, match=f"slot {slot} is damaged"), \
+            pytest.warns(RuntimeWarning, match="the 16 snapshots written after it"):
         with pytest.MonkeyPatch.context() as patch:
             patch.setattr(RunWriter, "_checkpoint", recording)
             runner.resume(path)
@@ -216,7 +217,8 @@ def test_a_file_written_without_checksums_opens_and_resumes(intact, tmp_path, mo
     interrupted(path)
     with h5py.File(path, "r+") as f:  # as a run killed after its first checkpoint leaves it
         f["checkpoint"].attrs["latest"] = "a"
-    runner.resume(path)  # from snapshot 0; the checkpoints are written again with checksums
+    with pytest.warns(RuntimeWarning, match="snapshots written after it"):
+        runner.resume(path)  # from snapshot 0; the checkpoints are written again with checksums
     assert summary(path)["stop_reason"] == "collisions"
     np.testing.assert_array_equal(read(path, POSITION), read(intact, POSITION))
     with h5py.File(path, "r") as f:

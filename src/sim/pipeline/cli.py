@@ -40,6 +40,7 @@ from sim.pipeline import callbacks
 from sim.pipeline.cli_exits import (
     EXIT_BREAKDOWN,
     EXIT_RUN_FILE,
+    Stopped,
     fail,
     quiet_hdf5_teardown,
     quiet_hdf5_traceback,
@@ -47,6 +48,7 @@ from sim.pipeline.cli_exits import (
     report_passed_over,
     stop_at_once,
     stopped,
+    stopped_in_a_job,
     stopped_status,
     terminate,
     warn_in_one_line,
@@ -56,7 +58,8 @@ from sim.pipeline.interruption import Interruption
 from sim.pipeline.overrides import (
     CONF_DIR,
     SWEEP_FLAGS,
-    sweep_flag_last,
+    flags_last,
+    prints_only,
     value_of,
     whole_numbers,
 )
@@ -108,7 +111,7 @@ def hydra_main(cfg):
         return {"failed": f"{type(error).__name__}: {error}"}
     except KeyboardInterrupt:
         if sweeping:
-            raise
+            raise Stopped() from None
         where = (f"the run file {path} keeps what was written; continue with: python -m sim "
                  f"resume={path}" if path.exists() else "nothing was written")
         remove_made_folders()
@@ -128,8 +131,9 @@ def hydra_main(cfg):
           f"error {info['energy_drift']:.1e}), stop reason: {info['stop_reason']}\n"
           f"run file: {path}", flush=True)
     if info["stop_reason"] in ("interrupted", "terminated"):
-        if sweeping:
-            raise KeyboardInterrupt  # a signal stops the whole sweep, not one job
+        if sweeping:  # a signal stops the whole sweep, not one job
+            raise Stopped(signal.SIGTERM if info["stop_reason"] == "terminated"
+                          else signal.SIGINT)
         INTERRUPTED.append((path, info["stop_reason"]))
     return str(path)
 
@@ -141,6 +145,7 @@ def main():
     sys.excepthook = quiet_hdf5_traceback
     atexit.register(report_passed_over)
     warnings.showwarning = warn_in_one_line
+    logging.raiseExceptions = False  # a log line to a closed pipe (| head) is dropped, silently
     Interruption.at_second_signal = stop_at_once
     args = whole_numbers(sys.argv[1:])
     sweeping = any(a in SWEEP_FLAGS for a in args)
@@ -148,18 +153,20 @@ def main():
         os.environ.setdefault("PYTHONWARNINGS", "ignore:resource_tracker:UserWarning")
     try:
         configs = check_command_line(args)
-        args = run_folder(args)
-        check_resources(args, configs)
+        if not prints_only(args):  # --cfg, --info, --hydra-help: no run, no folder
+            args = run_folder(args)
+            check_resources(args, configs)
         if sweeping and value_of(args, "hydra.sweep.dir") is not None:
             check_sweep_folder(args, configs)
-        sys.argv[1:] = sweep_flag_last(args)
+        sys.argv[1:] = flags_last(args)
         try:
             hydra_main()
         except SystemExit as stop:
             if stop.code not in (0, None):
                 remove_made_folders()  # those still empty: a refusal leaves none behind
             raise
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as stop:
+        stopped_in_a_job(stop)
         remove_made_folders()
         if sweeping:
             folder = value_of(args, "hydra.sweep.dir")

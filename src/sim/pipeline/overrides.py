@@ -42,10 +42,41 @@ def _integer(text):
     return text
 
 
+def hydra_arguments(args):
+    """The command line read by Hydra's own parser (an ``argparse`` namespace: its flags, and
+    ``overrides``). A flag it does not know, abbreviated or missing its value is one line,
+    exit 2, where argparse would print Hydra's usage text."""
+    from hydra._internal.utils import get_args_parser  # the parser ``hydra.main`` reads with
+
+    parser = get_args_parser()
+    parser.allow_abbrev = False  # --multi would be a sweep to Hydra, not to the checks here
+
+    def refuse(message):
+        fail(f"{message}: python -m sim takes KEY=VALUE overrides, -m (or --multirun) for a "
+             f"sweep, --help, and Hydra's flags (--hydra-help lists them)")
+
+    parser.error = refuse
+    known = parser.parse_intermixed_args(args)  # overrides before, between or after flags
+    commands = [flag for flag, given in (("--run", known.run), ("--multirun", known.multirun),
+                                         ("--cfg", known.cfg), ("--info", known.info),
+                                         ("--shell-completion", known.shell_completion))
+                if given]
+    if len(commands) > 1:  # Hydra's own check, a ValueError traceback there
+        refuse(f"{' and '.join(commands)} together; only one of them may be given")
+    return known
+
+
+def prints_only(args):
+    """Whether the command line asks Hydra to print something (``--cfg``, ``--info``,
+    ``--hydra-help``, ``--shell-completion``) instead of running."""
+    known = hydra_arguments(args)
+    return bool(known.cfg or known.info or known.hydra_help or known.shell_completion)
+
+
 def combinations(args):
     """Every job the command line asks for, as lists of overrides, in the order and numbering
     of Hydra's basic sweeper (a repeated key: the last one counts)."""
-    overrides = [a for a in args if not a.startswith("-")]
+    overrides = hydra_arguments(args).overrides
     try:
         parsed = OverridesParser.create().parse_overrides(overrides)
     except Exception as error:
@@ -113,11 +144,15 @@ def _quoted(text):
     return "'" + text.replace("'", "\\'") + "'"
 
 
-def sweep_flag_last(args):
-    """The command line with its sweep flag (-m, --multirun) last: Hydra's parser takes the
-    overrides as one run of words, which a flag between them would cut (``-m seed=0,1`` once a
-    folder override is put first)."""
-    return [*(a for a in args if a not in SWEEP_FLAGS), *(a for a in args if a in SWEEP_FLAGS)]
+def flags_last(args):
+    """The command line with its overrides first and its flags after them, in their order:
+    Hydra's parser takes the overrides as one run of words at the start, which a flag between
+    or before them would cut (``-m seed=0,1``, ``--cfg job seed=3``)."""
+    overrides = hydra_arguments(args).overrides
+    flags = list(args)
+    for item in overrides:
+        flags.remove(item)
+    return [*overrides, *flags]
 
 
 def with_value(args, key, value):

@@ -8,10 +8,10 @@ refuses a file whose data do not have the sizes its config implies.
 
 import logging
 import time as wallclock
+import warnings
 from pathlib import Path
 
 import h5py
-import yaml
 from omegaconf import OmegaConf
 from omegaconf.errors import ValidationError
 
@@ -22,7 +22,7 @@ from sim.pipeline.engine_from_config import build_engine
 from sim.pipeline.run_folder import locked
 from sim.pipeline.snapshots import advance, next_snapshot_time
 from sim.pipeline.stop_conditions import already_met, check_reachable
-from sim.pipeline.writing import new_run, open_writer, record
+from sim.pipeline.writing import open_writer, record
 from sim.storage.errors import RunFileError
 from sim.storage.h5md import read_checkpoint
 from sim.storage.inspect import open_run_file
@@ -70,6 +70,19 @@ def existing_file(path, key):
     return path
 
 
+def _literal(text):
+    """The YAML ``text`` of a stored config as data: every ``${`` escaped, so that OmegaConf
+    reads what the file holds and never resolves an interpolation (a config is stored
+    resolved; one found in it was put there since)."""
+    def escaped(node):
+        if isinstance(node, dict):
+            return {key: escaped(value) for key, value in node.items()}
+        if isinstance(node, list):
+            return [escaped(value) for value in node]
+        return node.replace("${", "\\${") if isinstance(node, str) else node
+    return escaped(OmegaConf.to_container(OmegaConf.create(text), resolve=False))
+
+
 def stored_config(path, key="resume"):
     """The resolved config and stop reason recorded in the run file ``path``; a file that is
     missing, a folder, not a run file or damaged is a :class:`ConfigError` on ``key``."""
@@ -79,18 +92,27 @@ def stored_config(path, key="resume"):
             attrs = f["parameters"].attrs
             text, reason = str(attrs["config"]), str(attrs["stop_reason"])
         stored = renamed_keys(OmegaConf.merge(OmegaConf.structured(SimConfig),
-                                              OmegaConf.create(text)), warn=False)
+                                              OmegaConf.create(_literal(text))), warn=False)
     except RunFileError as error:
         raise ConfigError(key, str(path), f"a readable run file: {error}") from error
     except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
         raise ConfigError(key, str(path), f"a run file with its config intact: "
                           f"{type(error).__name__}: {error}") from error
+    try:
+        validate(stored)
+    except (ConfigError, ValidationError) as error:  # a value edited in, read as it stands
+        wrong = error if isinstance(error, ConfigError) else ConfigError(
+            error.full_key, error.value, str(error.msg).splitlines()[0])
+        raise ConfigError(key, str(path), f"a run file with its config intact: its stored "
+                          f"{wrong.key}={wrong.value!r} is not allowed ({wrong.allowed})") \
+            from error
     return stored, reason
 
 
 def check_consistent(path, cfg, key="resume"):
-    """Refuse (:class:`ConfigError` on ``key``) a run file whose disks, box or checkpoint do
-    not have the sizes its stored config ``cfg`` implies (a config edited in the file)."""
+    """Refuse (:class:`ConfigError` on ``key``) a run file that has no checkpoint to continue
+    from, or whose disks, box or checkpoint do not have the sizes its stored config ``cfg``
+    implies (a config edited in the file)."""
     n, _ = resources.disk_count(cfg)
     periodic = cfg.box.boundary == "periodic"
     try:
@@ -100,8 +122,12 @@ def check_consistent(path, cfg, key="resume"):
                      "box": [float(x) for x in disks["box/edges"][()]],
                      "boundary": [b.decode() for b in disks["box"].attrs["boundary"]]}
             root = f.get("checkpoint")
-            if root is not None and "latest" in root.attrs:
-                found["checkpointed disks"] = root[root.attrs["latest"]]["disks/table"].shape[0]
+            if root is None or "latest" not in root.attrs:
+                frames = disks["position/step"].shape[0]
+                raise ConfigError(key, str(path), f"a run file with a checkpoint to continue "
+                                  f"from: it has none, and starting it again would overwrite "
+                                  f"its {frames} snapshots; start a new run in another folder")
+            found["checkpointed disks"] = root[root.attrs["latest"]]["disks/table"].shape[0]
     except (KeyError, OSError, RuntimeError) as error:  # RunFileError is an OSError
         raise ConfigError(key, str(path), f"a readable run file: "
                           f"{' '.join(str(error).split())}") from error
@@ -172,14 +198,6 @@ def resume_locked(path, stored, reason, overrides, started):
     differ = differences(stored, cfg)
     recorded = [item for item in overrides if item.partition("=")[0].lstrip("+~") in differ]
     changed = [item for item in recorded if item.partition("=")[0].lstrip("+~") not in COSMETIC]
-    with h5py.File(path, "r") as f:
-        checkpointed = "checkpoint" in f and "latest" in f["checkpoint"].attrs
-        made_by = yaml.safe_load(str(f["parameters"].attrs.get("overrides", "[]"))) or []
-    if not checkpointed:  # a file of a run that never reached its first checkpoint
-        engine = build_engine(cfg)
-        check_reachable(cfg, engine)
-        path.unlink()
-        return new_run(path, engine, cfg, made_by, started)
     if reason in FINISHED and not changed:
         log.info("%s is complete (stopped by %s); nothing to resume", path, reason)
         return path
@@ -188,6 +206,7 @@ def resume_locked(path, stored, reason, overrides, started):
     try:  # read-only: a refusal leaves the file as it was
         with h5py.File(path, "r") as f:
             state, last_time, snapshots, slot = read_checkpoint(f)
+            written = f["particles/disks/position/time"][snapshots:]
         engine.load_state_dict(state)
     except RunFileError as error:  # both checkpoints damaged
         raise ConfigError("resume", str(path), "a run file with an intact checkpoint; "
@@ -208,6 +227,11 @@ def resume_locked(path, stored, reason, overrides, started):
         return path
     check_reachable(cfg, engine)
     next_snapshot_time(last_time, cfg.output.every_time)
+    if len(written):  # flushed by a run killed between two checkpoints
+        warnings.warn(f"{path}: resuming from its checkpoint at t = {last_time:.6g} (snapshot "
+                      f"{snapshots - 1}); the {len(written)} snapshots written after it, to "
+                      f"t = {written[-1]:.6g}, are dropped and computed again from there",
+                      RuntimeWarning, stacklevel=2)
     writer = open_writer(path, engine, cfg, mode="r+", observers=observers)
 
     def from_the_checkpoint(interruption):

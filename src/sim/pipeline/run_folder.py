@@ -4,10 +4,16 @@ life, and a new run file that appears whole or not at all.
 * :func:`new_folder` makes a folder that no other process has: ``base``, else ``base-2``,
   ``base-3``, … (``mkdir`` is atomic, so two runs started in the same second get two folders).
 * :class:`RunLock` is an exclusive ``flock`` on the hidden file ``.run.h5.lock`` beside the
-  run file, taken before the run file is read or written and released when the run ends; the
-  kernel releases it when the process dies, so a killed run never leaves a stale lock. A
-  second process that asks for it is refused at once, naming the holder's pid. On a file
-  system without file locks (some Lustre and NFS mounts) the run goes on with a warning.
+  run file (beside the file a symbolic link points to), taken before the run file is read or
+  written and released when the run ends; the kernel releases it when the process dies, so a
+  killed run never leaves a stale lock. A second process that asks for it is refused at once,
+  naming the holder's pid. On a file system without file locks (some Lustre and NFS mounts)
+  the run goes on with a warning.
+* The run file itself, its device and inode whatever name or hard link reaches it, is locked
+  too (:func:`held`): by HDF5 while the file is open, or, where ``HDF5_USE_FILE_LOCKING`` turns
+  HDF5's locks off (usual on Lustre and NFS), by an ``flock`` of its own for as long as the
+  run holds it. The two cannot be taken together: HDF5's lock and another ``flock`` on the
+  same file exclude each other even within one process.
 * A new run file is written under the hidden name ``.run.h5.part`` (:func:`part_path`) and
   linked into place once its header, first snapshot and first checkpoint are on disk
   (:func:`publish`): a run killed at any moment leaves a readable run file or none.
@@ -55,7 +61,42 @@ def new_folder(base):
 
 
 def lock_path(path):
-    return Path(path).with_name(f".{Path(path).name}.lock")
+    """The lock file of the run file ``path``: beside the file its links lead to."""
+    real = Path(os.path.realpath(path))
+    return real.with_name(f".{real.name}.lock")
+
+
+#: Whether HDF5 locks the files it opens. ``HDF5_USE_FILE_LOCKING`` set to ``FALSE`` or ``0``
+#: turns its locks off; HDF5 reads it once, as the library starts (on importing h5py, before
+#: this module), so it is read here once too.
+HDF5_LOCKS_FILES = os.environ.get("HDF5_USE_FILE_LOCKING", "").strip().upper() not in ("FALSE",
+                                                                                      "0")
+
+
+@contextmanager
+def held(path):
+    """An exclusive ``flock`` on the file ``path`` itself, held inside the block, when HDF5's
+    own file locks are off (:data:`HDF5_LOCKS_FILES`); :class:`FolderBusyError` when another
+    process holds it, nothing where the file or the file system's locks are missing."""
+    if HDF5_LOCKS_FILES:
+        yield
+        return
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except FileNotFoundError:
+        yield
+        return
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise FolderBusyError(path, None) from None
+        except OSError as error:
+            if error.errno not in NO_LOCKS:
+                raise
+        yield
+    finally:
+        os.close(fd)
 
 
 def part_path(path):
@@ -71,6 +112,7 @@ class RunLock:
         self.path = Path(path)
         self.file = lock_path(path)
         self._fd = None
+        self._run_file = None  # held(path), entered
 
     def __enter__(self):
         while True:
@@ -105,9 +147,19 @@ class RunLock:
         os.write(fd, str(os.getpid()).encode())
         # what a run killed before publishing left behind; only the lock's holder writes it
         part_path(self.path).unlink(missing_ok=True)
+        run_file = held(self.path)
+        try:
+            run_file.__enter__()
+        except BaseException:  # FolderBusyError: the file is in use under another name
+            self.__exit__()
+            raise
+        self._run_file = run_file
         return self
 
     def __exit__(self, *exc):
+        if self._run_file is not None:
+            self._run_file.__exit__(None, None, None)
+            self._run_file = None
         if self._fd is not None:
             self.file.unlink(missing_ok=True)
             os.close(self._fd)

@@ -15,7 +15,7 @@ import sim
 from sim.analysis.observers import from_config as observers_from_config
 from sim.engine.errors import PhysicsBreakdown
 from sim.pipeline.interruption import Interruption
-from sim.pipeline.run_folder import cannot_write, part_path, publish
+from sim.pipeline.run_folder import cannot_write, held, part_path, publish
 from sim.pipeline.scenes import preparation
 from sim.pipeline.snapshots import advance
 from sim.storage.errors import RunFileError
@@ -116,7 +116,8 @@ def new_run(path, engine, cfg, overrides, started):
             published.append(path)
             return advance(engine, cfg, writer, 0.0, started, interruption)
 
-        record(writer, engine, from_the_start)
+        with held(part):  # the file, under every name it will have
+            record(writer, engine, from_the_start)
     except RunFileError as error:
         if published:
             raise
