@@ -5,20 +5,25 @@ GSD frames against the run's own ``radial_distribution`` observer.
 GSD holds positions, velocities, diameters, masses and the box as float32 (the HOOMD
 schema's type, gsd's default single precision): they are compared with the run's float64
 values rounded once to float32, exactly; positions after undoing the −L/2 shift agree to half
-a float32 ulp of L/2. XYZ holds float64 and is compared bit for bit.
+a float32 ulp of L/2. XYZ holds float64 and is compared bit for bit. Rough disks: GSD's
+moment_inertia and angmom against the run's ω and I = q m a², XYZ's spin column to the bit.
 """
 
+import errno
+import os
 import shlex
 import shutil
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import freud
 import gsd.hoomd
 import h5py
 import numpy as np
 import pytest
+import xarray as xr
 import yaml
 
 import sim.storage.export
@@ -26,7 +31,7 @@ from sim.analysis.datasets import open_run
 from sim.pipeline.command import BadInput
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
-from sim.storage.export import export, frame_indices, hoomd_positions, main
+from sim.storage.export import CANNOT_HOLD, export, frame_indices, hoomd_positions, main, not_held
 
 
 def make_run(folder, *overrides):
@@ -46,6 +51,13 @@ def gas(tmp_path_factory):
     return make_run(tmp_path_factory.mktemp("gas"), "box.boundary=periodic", "disks.n=1000",
                     "observe.radial_distribution.bins=50", "stop.collisions=10000",
                     "output.every_collisions=500")
+
+
+@pytest.fixture(scope="module")
+def rough(tmp_path_factory):
+    """Rough disks cooling (spins from rest, β = 0.5): 200 disks, 5 snapshots."""
+    return make_run(tmp_path_factory.mktemp("rough"), "scenario=rough_cooling", "disks.n=200",
+                    "stop.collisions=2000", "output.every_collisions=500")
 
 
 def sim_export(*argv):
@@ -132,6 +144,99 @@ def test_xyz_frames_are_the_snapshots_to_the_bit(name, pbc, request, tmp_path):
             np.testing.assert_array_equal(table[:, 8], ds["mass"].values)
 
 
+def test_rough_disks_carry_their_spins_in_both_formats(rough, tmp_path):
+    """GSD: moment_inertia (0, 0, I) and angmom (0, 0, 0, 2 I ω), HOOMD's P = 2 o ⊗ (0, S)
+    for S = (0, 0, I ω) and the identity orientation o, so that S = ½ im(o* ⊗ P) gives back
+    I ω; XYZ: a column spin, ω to the bit. I = q m a² is checked against the run's own
+    rotational energy Σ I ω²/2."""
+    gsd_file = export(rough, "gsd", tmp_path / "rough.gsd")
+    xyz_file = export(rough, "xyz", tmp_path / "rough.xyz")
+    with open_run(rough) as ds, gsd.hoomd.open(gsd_file) as trajectory:
+        q = yaml.safe_load(ds.attrs["config"])["disks"]["inertia_factor"]
+        inertia = q * ds["mass"].values * ds["radius"].values ** 2
+        spin = ds["angular_velocity"].values
+        np.testing.assert_allclose(0.5 * np.sum(inertia * spin**2, axis=1),
+                                   ds["rotational_energy"].values, rtol=1e-12)
+        assert np.abs(spin[-1]).max() > 10.0  # the disks turn
+        assert len(trajectory) == spin.shape[0]
+        for frame, omega in zip(trajectory, spin, strict=True):
+            np.testing.assert_array_equal(frame.particles.moment_inertia[:, 2],
+                                          inertia.astype(np.float32))
+            assert not frame.particles.moment_inertia[:, :2].any()
+            np.testing.assert_array_equal(frame.particles.angmom[:, 3],
+                                          (2.0 * inertia * omega).astype(np.float32))
+            assert not frame.particles.angmom[:, :3].any()
+            np.testing.assert_array_equal(frame.particles.orientation, [[1, 0, 0, 0]] * omega.size)
+            body = 0.5 * frame.particles.angmom[:, 3]  # ½ im(o* ⊗ P), o = 1
+            np.testing.assert_allclose(body / frame.particles.moment_inertia[:, 2], omega,
+                                       rtol=1e-6)
+        frames = read_xyz(xyz_file)
+        assert len(frames) == spin.shape[0]
+        for (keys, lines), omega in zip(frames, spin, strict=True):
+            assert keys["Properties"].endswith(":mass:R:1:spin:R:1")
+            np.testing.assert_array_equal(np.array(lines, dtype=np.float64)[:, 9], omega)
+
+
+def test_spins_without_an_inertia_factor_are_refused_for_gsd(rough, tmp_path, capsys):
+    """A run file whose config lacks disks.inertia_factor (a script's RunWriter): no moments
+    of inertia, so no GSD; xyz needs none."""
+    path = tmp_path / "run.h5"
+    shutil.copy(rough, path)
+    with h5py.File(path, "r+") as f:
+        config = yaml.safe_load(f["parameters"].attrs["config"])
+        del config["disks"]["inertia_factor"]
+        f["parameters"].attrs["config"] = yaml.safe_dump(config)
+    capsys.readouterr()
+    assert sim_export(path, "--format", "gsd") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no disks.inertia_factor" in err
+    assert [p.name for p in tmp_path.iterdir()] == ["run.h5"]
+    assert sim_export(path, "--format", "xyz") == 0
+
+
+def test_smooth_disks_keep_the_defaults_of_gsd(mixture, tmp_path):
+    """No spins in the run: no moment of inertia (HOOMD turns no such particle) and no
+    angular momentum."""
+    with gsd.hoomd.open(export(mixture, "gsd", tmp_path / "smooth.gsd")) as trajectory:
+        assert not trajectory[0].particles.moment_inertia.any()
+        assert not trajectory[-1].particles.angmom.any()
+
+
+@pytest.mark.parametrize(("name", "fmt", "says"), [
+    ("mixture", "gsd", "the walls along x and y read as periodic sides"),
+    ("mixture", "xyz", None), ("gas", "gsd", None), ("rough", "xyz", None)])
+def test_a_note_says_what_of_the_run_the_format_cannot_hold(name, fmt, says, request, tmp_path,
+                                                            capsys):
+    capsys.readouterr()
+    assert sim_export(request.getfixturevalue(name), "--format", fmt, "--out",
+                      tmp_path / f"x.{fmt}") == 0
+    out, err = capsys.readouterr()
+    assert out == ""
+    if says is None:
+        assert err == ""
+    else:
+        assert err.startswith("sim-export: note: ") and err.count("\n") == 1 and says in err
+
+
+@pytest.mark.parametrize(("boundary", "walls", "gsd_note", "xyz_note"), [
+    (["none", "none"], {"bottom": {"amplitude": 0.01, "frequency": 20.0}}, 2, 1),
+    (["none", "none"], {"top": {"speed": -0.1}, "left": None}, 2, 1),
+    (["none", "periodic"], {"top": {"speed": -0.1}}, 1, 0),  # no wall there: nothing moves
+    (["none", "none"], {"top": {"temperature": 1.0}}, 1, 0),
+    (["periodic", "periodic"], None, 0, 0),
+])
+def test_moving_walls_are_noted_in_either_format(boundary, walls, gsd_note, xyz_note):
+    run = xr.Dataset(attrs={"boundary": boundary, "config": yaml.safe_dump({"walls": walls})})
+    assert len(not_held(run, "gsd")) == gsd_note
+    assert len(not_held(run, "xyz")) == xyz_note
+    assert any("motion" in item for item in not_held(run, "xyz")) == bool(xyz_note)
+
+
+def test_the_help_says_what_the_formats_cannot_hold(capsys):
+    assert sim_export("--help") == 0
+    assert " ".join(CANNOT_HOLD.split()) in " ".join(capsys.readouterr().out.split())
+
+
 @pytest.mark.parametrize(("spec", "indices"), [
     (None, list(range(10))), ("::3", [0, 3, 6, 9]), ("2:5", [2, 3, 4]), ("-2:", [8, 9]),
     ("7:100", [7, 8, 9]), ("9:2:-3", [9, 6, 3]), (" 1, 4,-1", [1, 4, 9]), ("5", [5])])
@@ -192,6 +297,13 @@ BAD_INPUT = {
     "out of range": lambda run, folder: ([run, "--format", "gsd", "--frames", "0,6"], "6"),
     "no frame": lambda run, folder: ([run, "--format", "gsd", "--frames", "6:"], "6:"),
     "the run file": lambda run, folder: ([run, "--format", "xyz", "--out", run], "itself"),
+    "no folder": lambda run, folder: ([run, "--format", "gsd", "--out", folder / "no" / "x.gsd"],
+                                      "no folder"),
+    "a file as folder": lambda run, folder: ([run, "--format", "gsd", "--out", run / "x.gsd"],
+                                             "no folder"),
+    "a folder": lambda run, folder: ([run, "--format", "xyz", "--out", folder], "a folder"),
+    "in /proc": lambda run, folder: ([run, "--format", "gsd", "--out", "/proc/x.gsd"],
+                                     "--out /proc/x.gsd: cannot write in /proc"),
 }
 
 
@@ -209,12 +321,53 @@ def test_bad_input_is_one_line_exit_2_and_leaves_nothing(case, mixture, tmp_path
     assert sorted(tmp_path.rglob("*")) == before
 
 
-def test_an_output_that_cannot_be_written_is_one_line_exit_1(mixture, tmp_path, capsys):
+@pytest.fixture
+def read_only_folder(tmp_path, monkeypatch):
+    """A folder on a read-only file system, as the kernel has it (root, who runs some test
+    machines, writes through chmod): making a file there and removing one fail with EROFS,
+    even removing one that is not there (the kernel asks the mount for write access before it
+    looks the name up)."""
+    folder = tmp_path / "read_only"
+    folder.mkdir()
+
+    def read_only(call):
+        def on_the_mount(path, *args, **kwargs):
+            if Path(os.fsdecode(path)).parent == folder:
+                raise OSError(errno.EROFS, os.strerror(errno.EROFS), os.fsdecode(path))
+            return call(path, *args, **kwargs)
+        return on_the_mount
+
+    monkeypatch.setattr(os, "open", read_only(os.open))
+    monkeypatch.setattr(os, "unlink", read_only(os.unlink))
+    return folder
+
+
+@pytest.mark.parametrize("fmt", ["gsd", "xyz"])
+def test_a_read_only_folder_is_one_line_exit_2(fmt, mixture, read_only_folder, capsys):
+    """Refused before any snapshot is read, naming the path and the OS's reason; no traceback
+    from removing the hidden file that could not be made."""
+    out = read_only_folder / f"x.{fmt}"
     capsys.readouterr()
-    assert sim_export(mixture, "--format", "gsd", "--out", tmp_path / "no" / "x.gsd") == 1
+    assert sim_export(mixture, "--format", fmt, "--out", out) == 2
     _, err = capsys.readouterr()
-    assert err.startswith("sim-export: cannot write ") and err.count("\n") == 1
-    assert not (tmp_path / "no").exists()
+    assert err == (f"sim-export: --out {out}: cannot write in {read_only_folder} (Read-only "
+                   f"file system); a file in a folder that exists and may be written\n")
+    assert list(read_only_folder.iterdir()) == []
+
+
+def test_a_write_that_fails_midway_is_one_line_exit_1(mixture, tmp_path, monkeypatch, capsys):
+    """A full disk half-way through: one line, exit status 1, neither the output nor its
+    hidden part left."""
+    def disk_full(path, run, frames):
+        path.write_bytes(b"half a file")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+
+    monkeypatch.setitem(sim.storage.export.WRITERS, "gsd", disk_full)
+    capsys.readouterr()
+    assert sim_export(mixture, "--format", "gsd", "--out", tmp_path / "x.gsd") == 1
+    _, err = capsys.readouterr()
+    assert err == f"sim-export: cannot write {tmp_path / 'x.gsd'} (No space left on device)\n"
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])

@@ -190,6 +190,7 @@ def test_cluster_labels_follow_the_rule_of_the_observer(runs):
     (["RUN", "--color", "mood"], "--color"),
     (["RUN", "--out", "movie.avi"], ".mp4 or .gif"),
     (["RUN", "--out", "nowhere/movie.mp4"], "no folder"),
+    (["RUN", "--out", "not_a_run.h5/movie.mp4"], "no folder"),
 ])
 def test_bad_input_is_one_line_and_status_2(runs, tmp_path, monkeypatch, capsys, args, says):
     monkeypatch.chdir(tmp_path)
@@ -200,6 +201,79 @@ def test_bad_input_is_one_line_and_status_2(runs, tmp_path, monkeypatch, capsys,
     assert len(err.splitlines()) == 1 and says in err and err.startswith("sim-movie: ")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_run.h5"]
     assert not any(p.suffix in (".mp4", ".gif") for p in runs["periodic"].parent.iterdir())
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """A movie that reads its run or starts ffmpeg fails the test: refusals come first."""
+    def work(*args, **kwargs):
+        raise AssertionError("the run was read or ffmpeg started before the refusal")
+
+    monkeypatch.setattr(movie.make, "open_run", work)
+    monkeypatch.setattr(imageio_ffmpeg, "write_frames", work)
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--duration", "1e9"], "--duration 1e+09 at --fps 30 is 3e+10 frames: at most 100000"),
+    (["--frames", "100000000"], "--frames 100000000: at least one frame and at most 100000"),
+    (["--frames", "300000000", "--out", "m.gif"], "--frames 300000000"),
+    (["--fps", "120", "--duration", "1e6"], "--duration 1e+06 at --fps 120 is 1.2e+08 frames"),
+    (["--fps", "120", "--duration", "1e308"], "--duration 1e+308 at --fps 120 is inf frames"),
+    (["--frames", "100001"], "at most 100000 frames"),
+    (["--duration", "inf"], "--duration inf"),
+    (["--duration", "nan"], "--duration nan"),
+    (["--duration", "-1"], "--duration -1"),
+    (["--duration", "0"], "--duration 0"),
+    (["--frames", "-5"], "--frames -5"),
+    (["--fps", "nan"], "--fps nan"),
+    (["--fps", "inf"], "--fps inf"),
+    (["--fps", "-30"], "--fps -30"),
+])
+def test_frames_out_of_range_are_refused_before_any_work(runs, tmp_path, monkeypatch, capfd,
+                                                          no_work, args, says):
+    """The count of frames (--frames, or --fps × --duration) is checked against
+    MAX_FRAMES before the run is read: no allocation of one time per frame, no rendering."""
+    monkeypatch.chdir(tmp_path)
+    assert movie.main([str(runs["periodic"]), *args]) == 2
+    err = capfd.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("sim-movie: ") and says in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_gif_is_limited_to_the_frames_that_fit_in_memory(runs, tmp_path, monkeypatch, capfd,
+                                                           no_work):
+    """Pillow keeps every frame of a GIF (one byte a pixel, at most 912 × 704) until it writes
+    the file: with 1 GB available, half of it holds 778 of them."""
+    monkeypatch.setattr(movie.make, "available_memory", lambda: 1e9)
+    limit = int(0.5e9 // (912 * 704))
+    out = tmp_path / "m.gif"
+    for frames, status in ((limit + 1, 2), (50 * limit, 2)):
+        assert movie.main([str(runs["periodic"]), "--out", str(out), "--frames",
+                           str(frames)]) == status
+        err = capfd.readouterr().err
+        assert err.count("\n") == 1 and f"at most {limit} frames" in err and "GIF" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("out, says", [
+    ("/proc/x.mp4", "--out /proc/x.mp4: cannot write in /proc"),
+    ("/proc/x.gif", "--out /proc/x.gif: cannot write in /proc"),
+    ("FOLDER", "a folder"),
+])
+def test_an_output_that_cannot_be_written_is_refused_before_ffmpeg_starts(
+        runs, tmp_path, capfd, no_work, out, says):
+    """One line naming the path and the OS's reason, exit 2, before the run is read and
+    before ffmpeg starts (no ffmpeg lines, no "Broken pipe"), and nothing left behind."""
+    if out == "FOLDER":
+        out = tmp_path / "folder.mp4"
+        out.mkdir()
+    capfd.readouterr()
+    assert movie.main([str(runs["periodic"]), "--out", str(out), "--frames", "3"]) == 2
+    err = capfd.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("sim-movie: ") and says in err, err
+    assert "Broken pipe" not in err and "Traceback" not in err
+    assert [p.name for p in tmp_path.rglob("*")] == (["folder.mp4"] if "folder" in says
+                                                     else [])
 
 
 def test_the_command_runs_as_a_module():

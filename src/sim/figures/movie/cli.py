@@ -5,16 +5,22 @@ Frames evenly spaced in time (:mod:`sim.figures.movie.snapshots`), the disks col
 speed, species or cluster (:mod:`sim.figures.movie.colors`).
 
 MP4 (frame sides multiples of 16) through imageio-ffmpeg's ffmpeg; a GIF through Pillow when
-FILE ends in .gif, or when ffmpeg is unavailable (said in one line). FILE (default: RUN with
-.mp4) is written under a hidden name beside it and renamed once complete: exit status 0; 1
-when the movie cannot be written; 2, with one line on stderr, for bad input (no run file, a
-value out of range); 130 after Ctrl-C, 143 after SIGTERM. Nothing but a whole movie is left
-behind.
+FILE ends in .gif, or when ffmpeg is unavailable (said in one line). At most 100 000 frames
+(:data:`sim.figures.movie.snapshots.MAX_FRAMES`: frames are drawn one at a time, some 30 ms
+each); a GIF also at most as many as fit in half the available memory, Pillow keeping every
+frame (up to 912 × 704 bytes) until it writes the file
+(:func:`sim.figures.movie.make.frame_limit`).
+FILE (default: RUN with .mp4) is written under a hidden name beside it, made before any work,
+and renamed once complete: exit status 0; 2, with one line on stderr, for bad input (no run
+file, a value out of range, too many frames, a FILE whose folder does not exist or cannot be
+written), checked before the run's snapshots are read; 1 when writing fails later (a full
+disk); 130 after Ctrl-C, 143 after SIGTERM. Nothing but a whole movie is left behind.
 """
 
 import sys
 
-from sim.figures.movie.make import make_movie
+from sim.figures.movie.make import GIF_FRAME_BYTES, make_movie
+from sim.figures.movie.snapshots import DEFAULT_MAX_SECONDS, MAX_FPS, MAX_FRAMES
 from sim.pipeline.command import CannotWrite, Parser, run_command
 from sim.storage.errors import RunFileError
 
@@ -23,10 +29,15 @@ def main(argv=None):
     parser = Parser(prog="sim-movie", description=__doc__.splitlines()[0])
     parser.add_argument("run", help="run file (run.h5)")
     parser.add_argument("--out", help="movie file, .mp4 or .gif (default: RUN with .mp4)")
-    parser.add_argument("--fps", type=float, default=30.0, help="frames per second (30)")
+    parser.add_argument("--fps", type=float, default=30.0,
+                        help=f"frames per second, above 0 and at most {MAX_FPS:g} (30)")
     length = parser.add_mutually_exclusive_group()
-    length.add_argument("--duration", type=float, help="seconds of movie")
-    length.add_argument("--frames", type=int, help="number of frames")
+    limit = (f"at most {MAX_FRAMES} frames (each is drawn in some 30 ms), for a GIF also no more "
+             f"than fit in half the available memory ({GIF_FRAME_BYTES / 1e6:.2f} MB a frame)")
+    length.add_argument("--duration", type=float,
+                        help=f"seconds of movie: --duration × --fps frames, {limit} (default: one "
+                             f"frame per snapshot, at most {DEFAULT_MAX_SECONDS:g} s)")
+    length.add_argument("--frames", type=int, help=f"number of frames, {limit}")
     parser.add_argument("--color", default="speed", help="speed (default), species or cluster")
     parser.add_argument("--start", type=float, help="time of the first frame (first snapshot)")
     parser.add_argument("--stop", type=float, help="time of the last frame (last snapshot)")

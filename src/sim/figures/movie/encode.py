@@ -1,7 +1,6 @@
-"""Writing the frames: MP4 (H.264, yuv420p) through imageio-ffmpeg's ffmpeg, or a GIF through
-Pillow (GIF delays are whole hundredths of a second), under a hidden name renamed once whole."""
-
-import os
+"""Writing the frames: MP4 (H.264, yuv420p) through imageio-ffmpeg's ffmpeg, frame by frame, or
+a GIF through Pillow, which keeps every frame until it writes the file (GIF delays are whole
+hundredths of a second)."""
 
 from PIL import Image
 
@@ -47,14 +46,3 @@ def write_gif(path, pictures, fps):
     first.save(path, save_all=True, append_images=images, duration=round(1000.0 / fps),
                loop=0)
 
-
-def write_whole(out, write):
-    """``write(path)`` to a hidden name beside ``out``, renamed to ``out`` once it returns;
-    removed when it fails."""
-    partial = out.with_name(f".{out.stem}.{os.getpid()}.part{out.suffix}")
-    try:
-        write(partial)
-        os.replace(partial, out)
-    except BaseException:
-        partial.unlink(missing_ok=True)
-        raise

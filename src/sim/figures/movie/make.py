@@ -1,8 +1,10 @@
 """The movie of a run file: its frames chosen (:mod:`.snapshots`), coloured (:mod:`.colors`),
-drawn (:mod:`.picture`) and written whole (:mod:`.encode`). One line of note when the snapshot
-intervals the frames lie in hold more than :data:`MISSED_CONTACTS` contacts per disk on average
-(Δ > τ/10: more than 5 % of the drawn disks misplaced), and when a GIF replaces an MP4 for want
-of ffmpeg."""
+drawn (:mod:`.picture`) and written whole (:mod:`sim.storage.whole_file`, :mod:`.encode`).
+Everything that needs no run file is checked first (the colouring, the movie's name, the
+number of frames against :func:`frame_limit`, that the movie's folder can be written), then
+the run is read. One line of note when the snapshot intervals the frames lie in hold more than
+:data:`MISSED_CONTACTS` contacts per disk on average (Δ > τ/10: more than 5 % of the drawn
+disks misplaced), and when a GIF replaces an MP4 for want of ffmpeg."""
 
 import math
 from pathlib import Path
@@ -11,25 +13,46 @@ import numpy as np
 
 from sim.analysis.datasets import open_run
 from sim.figures.movie.colors import COLORINGS, coloring
-from sim.figures.movie.encode import ffmpeg_missing, write_gif, write_mp4, write_whole
+from sim.figures.movie.encode import ffmpeg_missing, write_gif, write_mp4
 from sim.figures.movie.layout import Layout
 from sim.figures.movie.picture import Picture, Walls
-from sim.figures.movie.snapshots import Snapshots, frame_times
+from sim.figures.movie.snapshots import MAX_FRAMES, Snapshots, frame_count, frame_times
 from sim.pipeline.command import BadInput
+from sim.pipeline.resources import available_memory
+from sim.storage.whole_file import whole_file
 
 #: contacts per disk per snapshot interval above which frames between snapshots get a note
 MISSED_CONTACTS = 0.1
+_SQUARE = Layout.of_view((0.0, 1.0, 0.0, 1.0))
+#: bytes a GIF frame holds until the GIF is written: Pillow keeps every frame, one byte (a
+#: palette index) per pixel, and the largest frame is that of a square view (912 × 704)
+GIF_FRAME_BYTES = _SQUARE.width * _SQUARE.height
+#: the share of the available memory a GIF's frames may take
+GIF_MEMORY_SHARE = 0.5
 
 
 def _output(run_path, out):
     """The movie's path: ``out``, or the run file's with .mp4; BadInput for a name that is
-    neither .mp4 nor .gif or a folder that does not exist."""
+    neither .mp4 nor .gif."""
     out = Path(run_path).with_suffix(".mp4") if out is None else Path(out)
     if out.suffix.lower() not in (".mp4", ".gif"):
         raise BadInput(f"--out {out}: a movie name ending in .mp4 or .gif")
-    if not out.parent.is_dir():
-        raise BadInput(f"--out {out}: no folder {out.parent}")
     return out
+
+
+def frame_limit(gif):
+    """The most frames of a movie, and why: :data:`MAX_FRAMES` (an MP4 is drawn and encoded
+    frame by frame); for a GIF also as many as fit in :data:`GIF_MEMORY_SHARE` of the
+    available memory (:func:`sim.pipeline.resources.available_memory`), Pillow holding every
+    frame, :data:`GIF_FRAME_BYTES` each, until it writes the file."""
+    if gif:
+        available = available_memory()
+        if GIF_MEMORY_SHARE * available < MAX_FRAMES * GIF_FRAME_BYTES:
+            return (int(GIF_MEMORY_SHARE * available // GIF_FRAME_BYTES),
+                    f"a GIF's frames stay in memory until it is written, "
+                    f"{GIF_FRAME_BYTES / 1e6:.2f} MB each, and may take half of the "
+                    f"{available / 1e9:.3g} GB available")
+    return MAX_FRAMES, "each is drawn in some 30 ms: an hour for the most"
 
 
 def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="speed",
@@ -42,9 +65,15 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
     if color not in COLORINGS:
         raise BadInput(f"--color {color}: one of {', '.join(COLORINGS)}")
     out = _output(run_path, out)
-    with open_run(run_path) as ds:
+    missing = ffmpeg_missing() if out.suffix.lower() == ".mp4" else None
+    if missing:
+        out = out.with_suffix(".gif")
+    gif = out.suffix.lower() == ".gif"
+    limit, why = frame_limit(gif)
+    count = frame_count(fps, frames, duration, limit, why)
+    with whole_file(out) as partial, open_run(run_path) as ds:
         snapshots = Snapshots(ds)
-        times = frame_times(snapshots.times, fps, frames, duration, start, stop)
+        times = frame_times(snapshots.times, fps, count, start, stop, limit)
         spacing = (times[-1] - times[0]) / max(times.size - 1, 1)
         between, missed, interval = snapshots.missed_contacts(times)
         if missed > MISSED_CONTACTS:
@@ -54,11 +83,8 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
                  f"each other and walls there; snapshots every "
                  f"{interval * MISSED_CONTACTS / missed:.2g} time units (output.every_time) "
                  f"would keep that below {MISSED_CONTACTS}")
-        missing = ffmpeg_missing() if out.suffix.lower() == ".mp4" else None
         if missing:
-            note(f"sim-movie: {missing}; writing {out.with_suffix('.gif')} through Pillow "
-                 f"instead")
-            out = out.with_suffix(".gif")
+            note(f"sim-movie: {missing}; writing {out} through Pillow instead")
         radius = ds["radius"].values.astype(np.float64)
         mass = ds["mass"].values.astype(np.float64)
         colors = coloring(color, snapshots, times, radius, mass)
@@ -68,9 +94,8 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
         picture = Picture(layout, walls, colors, radius, mass,
                           f"{ds.attrs['scene']}: {ds.sizes['disk']} disks", decimals)
         pictures = (picture.render(frame) for frame in snapshots.frames(times))
-        if out.suffix.lower() == ".gif":
-            write_whole(out, lambda path: write_gif(path, pictures, fps))
+        if gif:
+            write_gif(partial, pictures, fps)
         else:
-            size = (layout.width, layout.height)
-            write_whole(out, lambda path: write_mp4(path, pictures, size, fps, times.size))
+            write_mp4(partial, pictures, (layout.width, layout.height), fps, times.size)
     return out

@@ -1,9 +1,10 @@
 """A run's snapshots and the times of a movie's frames.
 
 Frames are evenly spaced in simulated time from --start to --stop (default: the first and the
-last snapshot), one per snapshot in between (at most 30 s of movie) unless --frames or
---duration (seconds of movie at --fps) says otherwise. A frame at time t draws each disk in
-free flight from the latest snapshot k at or before t, never back from a later one:
+last snapshot), one per snapshot in between (at most 30 s of movie, and at most the limit of
+:func:`frame_count`) unless --frames or --duration (seconds of movie at --fps) says otherwise;
+a count asked for above that limit is refused before any work. A frame at time t draws each
+disk in free flight from the latest snapshot k at or before t, never back from a later one:
 r = r_k + v_k (t − t_k) + ½ g (t − t_k)² and v = v_k + g (t − t_k), g the run's gravity (box
 units / time²), r wrapped into the box along periodic axes.
 Contacts between snapshots are not drawn: between two snapshots a disk may pass through a
@@ -26,6 +27,11 @@ from sim.pipeline.command import BadInput
 DEFAULT_MAX_SECONDS = 30.0
 #: the fastest frame rate accepted (frames per second)
 MAX_FPS = 120.0
+#: the most frames of a movie: frames are drawn and encoded one at a time (some 30 ms each for
+#: 200 disks, more for more disks), so time, not memory, bounds an MP4: 100 000 frames are
+#: 56 min of movie at 30 fps and about an hour of drawing; what is kept per frame (its time,
+#: its snapshot, the walls' places) takes a few hundred bytes, some 25 MB for the most
+MAX_FRAMES = 100_000
 
 
 def free_flight(position, velocity, elapsed, gravity=None, box=None, periodic=(False, False)):
@@ -115,12 +121,32 @@ class Snapshots:
                 float(np.mean(interval)))
 
 
-def frame_times(snapshot_times, fps, frames=None, duration=None, start=None, stop=None):
-    """Times float64[F] of the frames, evenly spaced from ``start`` to ``stop`` (default the
-    first and last snapshot): ``frames`` of them, or ``duration`` × ``fps``, or one per
-    snapshot in between (at most DEFAULT_MAX_SECONDS of movie). Bad values: BadInput."""
+def frame_count(fps, frames, duration, limit, why):
+    """The number of frames asked for: ``frames``, or ``duration`` × ``fps`` rounded; None when
+    neither is given (one per snapshot, :func:`frame_times`). BadInput, before any work, for a
+    rate, a length or a count out of range or a count above ``limit`` (``why``: its reason)."""
     if not 0.0 < fps <= MAX_FPS:
         raise BadInput(f"--fps {fps}: a frame rate above 0 and at most {MAX_FPS:g}")
+    beyond = f"at most {limit} frames ({why})"
+    if duration is not None:
+        if not 0.0 < duration < math.inf:
+            raise BadInput(f"--duration {duration}: seconds of movie, above 0 and finite")
+        if duration * fps >= limit + 0.5:
+            raise BadInput(f"--duration {duration:g} at --fps {fps:g} is {duration * fps:.3g} "
+                           f"frames: {beyond}, so --duration up to {limit / fps:.6g}")
+        frames = round(duration * fps)
+        if frames < 1:
+            raise BadInput(f"--duration {duration} at --fps {fps:g} is less than one frame")
+    elif frames is not None and not 1 <= frames <= limit:
+        raise BadInput(f"--frames {frames}: at least one frame and {beyond}")
+    return frames
+
+
+def frame_times(snapshot_times, fps, count=None, start=None, stop=None, limit=MAX_FRAMES):
+    """Times float64[F] of the frames, evenly spaced from ``start`` to ``stop`` (default the
+    first and last snapshot): ``count`` of them (:func:`frame_count`), or one per snapshot in
+    between (at most DEFAULT_MAX_SECONDS of movie at ``fps`` and at most ``limit``). Bad
+    values: BadInput."""
     first, last = float(snapshot_times[0]), float(snapshot_times[-1])
     start = first if start is None else start
     stop = last if stop is None else stop
@@ -128,19 +154,12 @@ def frame_times(snapshot_times, fps, frames=None, duration=None, start=None, sto
         raise BadInput(f"--start {start:.6g} and --stop {stop:.6g}: the run's snapshots span "
                          f"t = {first:.6g} to {last:.6g}; a frame is drawn only from a snapshot "
                          f"before it, so give {first:.6g} ≤ start ≤ stop ≤ {last:.6g}")
-    if duration is not None:
-        if not 0.0 < duration < math.inf:
-            raise BadInput(f"--duration {duration}: seconds of movie, above 0")
-        frames = round(duration * fps)
-        if frames < 1:
-            raise BadInput(f"--duration {duration} at --fps {fps:g} is less than one frame")
-    elif frames is None:
+    if count is None:
         inside = snapshot_times[(snapshot_times >= start) & (snapshot_times <= stop)]
         distinct = int(np.sum(np.diff(inside) > round_off(snapshot_times))) + 1
-        frames = max(1 if start == stop else 2, min(distinct, round(DEFAULT_MAX_SECONDS * fps)))
-    if frames < 1:
-        raise BadInput(f"--frames {frames}: at least one frame")
-    if frames > 1 and start == stop:
+        count = max(1 if start == stop else 2,
+                    min(distinct, round(DEFAULT_MAX_SECONDS * fps), limit))
+    if count > 1 and start == stop:
         raise BadInput(f"--start and --stop are both {start:.6g}: one frame only "
                          f"(--frames 1)")
-    return np.linspace(start, stop, frames)
+    return np.linspace(start, stop, count)
