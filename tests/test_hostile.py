@@ -325,6 +325,9 @@ BAD_INPUT = {
                              "restitution.wall_tangential"),
     "rough-pressure-tensor": ("restitution.tangential=0.5 observe.pressure_tensor=true",
                               "observe.pressure_tensor"),
+    # words that are no override: a value cut at a space the shell split, a bare word
+    "path-with-a-space-unquoted": ("hydra.run.dir=my runs/x", "quoted"),
+    "a-bare-word": ("gas", "KEY=VALUE"),
     # flags Hydra's parser refuses, in one line instead of its usage text
     "flag-unknown": ("--no-such-flag", "--no-such-flag"),
     "flag-short-unknown": ("-x disks.n=10", "-x"),

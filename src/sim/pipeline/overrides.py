@@ -99,11 +99,17 @@ def _unreadable(overrides, error):
         try:
             parser.parse_override(override)
         except Exception as failure:
-            key, _, value = override.partition("=")
+            key, equals, value = override.partition("=")
             shown = value if len(value) <= 40 else f"{value[:20]}… ({len(value)} characters)"
             reason = str(failure).strip().splitlines()[0] if str(failure).strip() else ""
             if "Exceeds the limit" in reason:  # Python's cap on the digits of an int
                 reason = f"a number, not one of {len(value)} digits"
+            if not equals:  # a word cut from the value before it by a space
+                at = overrides.index(override)
+                before = f" after {overrides[at - 1]}" if at else ""
+                return (f"{override!r}{before} is not allowed: an override is KEY=VALUE; a "
+                        f"value with spaces is quoted whole, 'KEY=a value' (the shell splits "
+                        f"it at the space)")
             return f"{key}={shown} is not allowed: {reason or first_line(failure)}"
     return first_line(error)
 
