@@ -84,8 +84,9 @@ def _literal(text):
 
 
 def stored_config(path, key="resume"):
-    """The resolved config and stop reason recorded in the run file ``path``; a file that is
-    missing, a folder, not a run file or damaged is a :class:`ConfigError` on ``key``."""
+    """The config and stop reason recorded in the run file ``path``, the config read as data
+    (:func:`_literal`) and validated; a file that is missing, a folder, not a run file or
+    damaged, or a stored value not allowed, is a :class:`ConfigError` on ``key``."""
     path = existing_file(path, key)
     try:
         with open_run_file(path) as f:
