@@ -304,7 +304,16 @@ BAD_INPUT = {
     "a folder": lambda run, folder: ([run, "--format", "xyz", "--out", folder], "a folder"),
     "in /proc": lambda run, folder: ([run, "--format", "gsd", "--out", "/proc/x.gsd"],
                                      "--out /proc/x.gsd: cannot write in /proc"),
+    # a device (/dev/full, /dev/null) was replaced by the file: a pipe stands for them here
+    "a pipe": lambda run, folder: ([run, "--format", "xyz", "--out", _pipe(folder)],
+                                   "not a regular file"),
 }
+
+
+def _pipe(folder):
+    """A named pipe in ``folder``: a file that is not a regular one."""
+    os.mkfifo(folder / "pipe.xyz")
+    return folder / "pipe.xyz"
 
 
 @pytest.mark.parametrize("case", list(BAD_INPUT), ids=list(BAD_INPUT))
@@ -319,6 +328,8 @@ def test_bad_input_is_one_line_exit_2_and_leaves_nothing(case, mixture, tmp_path
     assert out == "" and err.startswith("sim-export: ") and err.count("\n") == 1
     assert named in err and "Traceback" not in err
     assert sorted(tmp_path.rglob("*")) == before
+    assert all(p.is_dir() or p.is_file() or p.is_fifo() and p.name == "pipe.xyz"
+               for p in before)  # the pipe is still one
 
 
 @pytest.fixture

@@ -2,6 +2,7 @@
 latest snapshot, drawn where the positions say; MP4 or GIF written whole; bad input is one line and
 exit status 2."""
 
+import os
 import subprocess
 import sys
 import warnings
@@ -259,6 +260,7 @@ def test_a_gif_is_limited_to_the_frames_that_fit_in_memory(runs, tmp_path, monke
     ("/proc/x.mp4", "--out /proc/x.mp4: cannot write in /proc"),
     ("/proc/x.gif", "--out /proc/x.gif: cannot write in /proc"),
     ("FOLDER", "a folder"),
+    ("PIPE", "not a regular file"),  # for a device such as /dev/null, which it replaced
 ])
 def test_an_output_that_cannot_be_written_is_refused_before_ffmpeg_starts(
         runs, tmp_path, capfd, no_work, out, says):
@@ -267,13 +269,17 @@ def test_an_output_that_cannot_be_written_is_refused_before_ffmpeg_starts(
     if out == "FOLDER":
         out = tmp_path / "folder.mp4"
         out.mkdir()
+    elif out == "PIPE":
+        out = tmp_path / "pipe.mp4"
+        os.mkfifo(out)
     capfd.readouterr()
     assert movie.main([str(runs["periodic"]), "--out", str(out), "--frames", "3"]) == 2
     err = capfd.readouterr().err
     assert err.count("\n") == 1 and err.startswith("sim-movie: ") and says in err, err
     assert "Broken pipe" not in err and "Traceback" not in err
-    assert [p.name for p in tmp_path.rglob("*")] == (["folder.mp4"] if "folder" in says
-                                                     else [])
+    left = {"a folder": ["folder.mp4"], "not a regular file": ["pipe.mp4"]}.get(says, [])
+    assert [p.name for p in tmp_path.rglob("*")] == left
+    assert says != "not a regular file" or out.is_fifo()
 
 
 def test_the_command_runs_as_a_module():
