@@ -48,8 +48,8 @@ SMALL = ["disks.n=200", "stop.collisions=2000"]
 
 
 def tree(root):
-    """{relative path: sha256 of a file, or "dir"} of everything under ``root``, hidden
-    entries included."""
+    """{relative path: sha256 of a file, "dir", or "not a regular file"} of everything under
+    ``root``, hidden entries included."""
     root = Path(root)
     out = {}
     for folder, dirs, files in os.walk(root):
@@ -57,6 +57,9 @@ def tree(root):
             out[str((Path(folder) / name).relative_to(root)) + "/"] = "dir"
         for name in files:
             path = Path(folder) / name
+            if not path.is_file():  # a named pipe: reading it would wait for a writer
+                out[str(path.relative_to(root))] = "not a regular file"
+                continue
             digest = hashlib.sha256()
             with open(path, "rb") as handle:
                 for block in iter(lambda: handle.read(1 << 20), b""):
@@ -335,6 +338,12 @@ BAD_INPUT = {
     "flag-without-its-value": ("--cfg", "--cfg"),
     "flag-value-not-a-choice": ("--cfg=everything", "--cfg"),
     "flags-that-exclude-each-other": ("--cfg job seed=0,1 -m", "--cfg"),
+    "flag-shell-completion": ("--shell-completion", "--shell-completion"),
+    "flag-experimental-rerun": ("--experimental-rerun config.pickle", "--experimental-rerun"),
+    "flag-config-name": ("-cn nosuch", "--config-name"),
+    "flag-config-path": ("-cp /tmp", "--config-path"),
+    "flag-config-dir": ("--config-dir /nonexistent", "--config-dir"),
+    "hydra-mode": ("hydra.mode=MULTIRUN disks.n=100,120", "hydra.mode"),
 }
 
 
@@ -510,6 +519,8 @@ BAD_RESUME = {
                                              good.read_bytes()[: good.stat().st_size // 2]),
     "foreign-hdf5": lambda folder, good: _then(_foreign, folder / "foreign.h5"),
     "garbage-config": lambda folder, good: _then(_garbage_config, good),
+    "named-pipe": lambda folder, good: _then(os.mkfifo, folder / "pipe.h5"),  # hung
+    "proc-file": lambda folder, good: Path("/proc/self/mem"),  # exit 1: no lock file in /proc
 }
 
 #: run files that open but cannot be continued
@@ -540,6 +551,18 @@ def test_inspect_of_what_is_not_a_run_file_is_one_line(case, small_run, tmp_path
     code = inspect.main([str(target)])
     out, err = capsys.readouterr()
     check(Result(code, out, err), 2, [target.name], before, tree(tmp_path), nothing_new=True)
+
+
+def test_a_named_pipe_as_the_run_file_of_a_new_run_is_refused(entry, tmp_path):
+    """A run folder whose run.h5 is a named pipe: refused, not a wait for a writer."""
+    (tmp_path / "X").mkdir()
+    os.mkfifo(tmp_path / "X" / "run.h5")
+    before = tree(tmp_path)
+    from sim.pipeline.run_cache import compose_config
+
+    with pytest.raises(ConfigError, match="not a regular file"):
+        runner.run(compose_config([*SMALL, QUIET]), tmp_path / "X")
+    assert tree(tmp_path) == before
 
 
 @pytest.mark.parametrize("extra", [[], ["stop.collisions=4000"]], ids=["plain", "longer"])

@@ -45,7 +45,8 @@ def _integer(text):
 def hydra_arguments(args):
     """The command line read by Hydra's own parser (an ``argparse`` namespace: its flags, and
     ``overrides``). A flag it does not know, abbreviated or missing its value is one line,
-    exit 2, where argparse would print Hydra's usage text."""
+    exit 2, where argparse would print Hydra's usage text; so are Hydra's flags that choose
+    other configs or replay a job, and ``hydra.mode`` (the sweep flag sets it)."""
     from hydra._internal.utils import get_args_parser  # the parser ``hydra.main`` reads with
 
     parser = get_args_parser()
@@ -63,14 +64,25 @@ def hydra_arguments(args):
                 if given]
     if len(commands) > 1:  # Hydra's own check, a ValueError traceback there
         refuse(f"{' and '.join(commands)} together; only one of them may be given")
+    for flag, given in (("--config-path", known.config_path),
+                        ("--config-name", known.config_name),
+                        ("--config-dir", known.config_dir),
+                        ("--experimental-rerun", known.experimental_rerun),
+                        ("--shell-completion", known.shell_completion)):
+        if given:
+            fail(f"{flag} is not taken by python -m sim: its configs are the package's conf/, "
+                 f"a scene is chosen with scenario=NAME and a run continued with "
+                 f"resume=RUN_FILE")
+    if any(item.partition("=")[0].lstrip("+~") == "hydra.mode" for item in known.overrides):
+        fail("hydra.mode is not set on the command line: -m (or --multirun) makes a sweep")
     return known
 
 
 def prints_only(args):
     """Whether the command line asks Hydra to print something (``--cfg``, ``--info``,
-    ``--hydra-help``, ``--shell-completion``) instead of running."""
+    ``--hydra-help``) instead of running."""
     known = hydra_arguments(args)
-    return bool(known.cfg or known.info or known.hydra_help or known.shell_completion)
+    return bool(known.cfg or known.info or known.hydra_help)
 
 
 def combinations(args):

@@ -57,7 +57,8 @@ def describe_differences(differ):
 
 
 def existing_file(path, key):
-    """``path`` as a run file's path: a folder or a missing file is a :class:`ConfigError`."""
+    """``path`` as a run file's path: a folder, a missing or empty file or one that is not a
+    regular file (a named pipe, a device) is a :class:`ConfigError`."""
     if not str(path).strip():
         raise ConfigError(key, str(path), "the path of a run file")
     path = Path(path)
@@ -67,6 +68,11 @@ def existing_file(path, key):
         raise ConfigError(key, str(path), f"a run file, not a folder{hint}")
     if not path.exists():
         raise ConfigError(key, str(path), "an existing run file: there is no such file")
+    if not path.is_file():  # opening a named pipe would wait for a writer
+        raise ConfigError(key, str(path), "a run file: this is not a regular file (a device, "
+                                          "pipe or socket)")
+    if path.stat().st_size == 0:
+        raise ConfigError(key, str(path), "a run file: this file is empty")
     return path
 
 

@@ -82,7 +82,7 @@ def held(path):
         yield
         return
     try:
-        fd = os.open(path, os.O_RDONLY)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)  # a named pipe: no wait for a writer
     except FileNotFoundError:
         yield
         return

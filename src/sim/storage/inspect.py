@@ -45,6 +45,9 @@ def open_run_file(path):
         raise RunFileError(f"{path} is a folder, not a run file")
     if not Path(path).exists():
         raise RunFileError(f"{path}: no such file")
+    if not Path(path).is_file():  # opening a named pipe would wait for a writer
+        raise RunFileError(f"{path} is not a regular file (a device, pipe or socket), not a "
+                           f"run file")
     try:
         f = h5py.File(path, "r")
     except (OSError, ValueError) as error:
