@@ -229,6 +229,10 @@ def no_work(monkeypatch):
     (["--fps", "nan"], "--fps nan"),
     (["--fps", "inf"], "--fps inf"),
     (["--fps", "-30"], "--fps -30"),
+    (["--fps", "0.001", "--duration", "3000", "--out", "m.gif"], "--fps 0.001"),  # Pillow's
+    (["--fps", "1e-300", "--duration", "1e300"], "--fps 1e-300"),  # ffmpeg's broken pipe
+    (["--frames", "2.5"], "whole number"),
+    (["--frames", "nan"], "whole number"),
 ])
 def test_frames_out_of_range_are_refused_before_any_work(runs, tmp_path, monkeypatch, capfd,
                                                           no_work, args, says):
@@ -239,6 +243,18 @@ def test_frames_out_of_range_are_refused_before_any_work(runs, tmp_path, monkeyp
     err = capfd.readouterr().err
     assert err.count("\n") == 1 and err.startswith("sim-movie: ") and says in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_frames_written_as_a_float_are_taken_when_whole(runs, tmp_path):
+    out = tmp_path / "m.gif"
+    assert movie.main([str(runs["periodic"]), "--out", str(out), "--frames", "2e0"]) == 0
+    assert out.is_file()
+
+
+def test_the_help_begins_with_what_the_command_makes(capsys):
+    with pytest.raises(SystemExit):
+        movie.main(["--help"])
+    assert "A movie of a run file" in capsys.readouterr().out
 
 
 def test_a_gif_is_limited_to_the_frames_that_fit_in_memory(runs, tmp_path, monkeypatch, capfd,

@@ -17,27 +17,41 @@ written), checked before the run's snapshots are read; 1 when writing fails late
 disk); 130 after Ctrl-C, 143 after SIGTERM. Nothing but a whole movie is left behind.
 """
 
+import argparse
+import math
 import sys
 
 from sim.figures.movie.make import GIF_FRAME_BYTES, make_movie
-from sim.figures.movie.snapshots import DEFAULT_MAX_SECONDS, MAX_FPS, MAX_FRAMES
+from sim.figures.movie.snapshots import DEFAULT_MAX_SECONDS, MAX_FPS, MAX_FRAMES, MIN_FPS
 from sim.pipeline.command import CannotWrite, Parser, run_command
 from sim.storage.errors import RunFileError
 
 
+def whole_number(text):
+    """``--frames`` as written: a whole number, also as ``2e3`` or ``2000.0``; anything else
+    is the option's refusal (argparse's "invalid value")."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number of frames") from None
+    if not (math.isfinite(value) and value == int(value)):
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number of frames")
+    return int(value)
+
+
 def main(argv=None):
-    parser = Parser(prog="sim-movie", description=__doc__.splitlines()[0])
+    parser = Parser(prog="sim-movie", description="A movie of a run file (MP4, or a GIF).")
     parser.add_argument("run", help="run file (run.h5)")
     parser.add_argument("--out", help="movie file, .mp4 or .gif (default: RUN with .mp4)")
     parser.add_argument("--fps", type=float, default=30.0,
-                        help=f"frames per second, above 0 and at most {MAX_FPS:g} (30)")
+                        help=f"frames per second, from {MIN_FPS:g} to {MAX_FPS:g} (30)")
     length = parser.add_mutually_exclusive_group()
     limit = (f"at most {MAX_FRAMES} frames (each is drawn in some 30 ms), for a GIF also no more "
              f"than fit in half the available memory ({GIF_FRAME_BYTES / 1e6:.2f} MB a frame)")
     length.add_argument("--duration", type=float,
                         help=f"seconds of movie: --duration × --fps frames, {limit} (default: one "
                              f"frame per snapshot, at most {DEFAULT_MAX_SECONDS:g} s)")
-    length.add_argument("--frames", type=int, help=f"number of frames, {limit}")
+    length.add_argument("--frames", type=whole_number, help=f"number of frames, {limit}")
     parser.add_argument("--color", default="speed", help="speed (default), species or cluster")
     parser.add_argument("--start", type=float, help="time of the first frame (first snapshot)")
     parser.add_argument("--stop", type=float, help="time of the last frame (last snapshot)")

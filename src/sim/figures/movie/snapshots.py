@@ -27,6 +27,9 @@ from sim.pipeline.command import BadInput
 DEFAULT_MAX_SECONDS = 30.0
 #: the fastest frame rate accepted (frames per second)
 MAX_FPS = 120.0
+#: the slowest frame rate accepted: one frame a second (a GIF's frame delay is a 16-bit count
+#: of hundredths of a second, and ffmpeg refuses rates far below)
+MIN_FPS = 1.0
 #: the most frames of a movie: frames are drawn and encoded one at a time (some 30 ms each for
 #: 200 disks, more for more disks), so time, not memory, bounds an MP4: 100 000 frames are
 #: 56 min of movie at 30 fps and about an hour of drawing; what is kept per frame (its time,
@@ -125,8 +128,9 @@ def frame_count(fps, frames, duration, limit, why):
     """The number of frames asked for: ``frames``, or ``duration`` × ``fps`` rounded; None when
     neither is given (one per snapshot, :func:`frame_times`). BadInput, before any work, for a
     rate, a length or a count out of range or a count above ``limit`` (``why``: its reason)."""
-    if not 0.0 < fps <= MAX_FPS:
-        raise BadInput(f"--fps {fps}: a frame rate above 0 and at most {MAX_FPS:g}")
+    if not MIN_FPS <= fps <= MAX_FPS:
+        raise BadInput(f"--fps {fps}: a frame rate from {MIN_FPS:g} to {MAX_FPS:g} frames a "
+                       f"second")
     beyond = f"at most {limit} frames ({why})"
     if duration is not None:
         if not 0.0 < duration < math.inf:
