@@ -578,6 +578,24 @@ def test_resume_of_a_run_file_whose_config_was_edited_is_refused(extra, small_ru
     assert tree(tmp_path) == before  # nothing changed, nothing new
 
 
+@pytest.mark.parametrize("key, value, names", [("seed", 7, "velocities"),
+                                                ("disks.mass", 2.0, "masses")])
+def test_resume_of_a_file_whose_config_makes_another_first_snapshot_is_refused(
+        key, value, names, small_run, tmp_path):
+    """A seed or a mass edited in the stored config: sizes agree, but the config no longer
+    makes the file's first snapshot, and the run would go on with other bits."""
+    good = copy_run(small_run, tmp_path)
+    with h5py.File(good, "r+") as f:
+        config = yaml.safe_load(str(f["parameters"].attrs["config"]))
+        section, _, name = key.rpartition(".")
+        (config[section] if section else config)[name] = value
+        f["parameters"].attrs["config"] = yaml.safe_dump(config)
+    before = tree(tmp_path)
+    with pytest.raises(ConfigError, match=f"resume.*first snapshot.*{names}"):
+        runner.resume(good, ["stop.collisions=4000"])
+    assert tree(tmp_path) == before
+
+
 def test_resume_into_another_run_folder_is_refused(entry, small_run, tmp_path):
     good = copy_run(small_run, tmp_path)
     before = tree(tmp_path)

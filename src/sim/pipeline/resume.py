@@ -12,6 +12,7 @@ import warnings
 from pathlib import Path
 
 import h5py
+import numpy as np
 from omegaconf import OmegaConf
 from omegaconf.errors import ValidationError
 
@@ -148,6 +149,28 @@ def check_consistent(path, cfg, key="resume"):
                           f"(edited since the run?): {'; '.join(wrong)}")
 
 
+def check_first_snapshot(path, engine):
+    """Refuse (:class:`ConfigError` on ``resume``) a run file whose first snapshot, masses or
+    radii are not those its stored config makes (``engine``, built from it and not yet run):
+    a seed, mass or placement edited in the file would continue the run with other bits."""
+    try:
+        with open_run_file(path) as f:
+            disks = f["particles/disks"]
+            stored = {"positions": disks["position/value"][0],
+                      "velocities": disks["velocity/value"][0],
+                      "masses": disks["mass"][()], "radii": disks["radius"][()]}
+    except (KeyError, OSError, IndexError) as error:  # RunFileError is an OSError
+        raise ConfigError("resume", str(path), f"a readable run file: "
+                          f"{' '.join(str(error).split())}") from error
+    made = {"positions": engine.positions(0.0), "velocities": engine.velocities(0.0),
+            "masses": engine.mass, "radii": engine.radius}
+    differ = [name for name in stored if not np.array_equal(stored[name], made[name])]
+    if differ:
+        raise ConfigError("resume", str(path), f"a run file whose stored config makes its "
+                          f"first snapshot; the {' and '.join(differ)} it makes differ (a config "
+                          f"edited in the file, or a file of another version of sim)")
+
+
 def resumable(path, overrides=()):
     """The config ``resume(path, overrides)`` would run, validated, after the checks of the
     file that need no engine: a run file, not in use, its data of the sizes its config
@@ -209,6 +232,7 @@ def resume_locked(path, stored, reason, overrides, started):
         log.info("%s is complete (stopped by %s); nothing to resume", path, reason)
         return path
     engine = build_engine(cfg)
+    check_first_snapshot(path, engine)
     observers = observers_from_config(cfg, engine)  # they remember the start of the run
     try:  # read-only: a refusal leaves the file as it was
         with h5py.File(path, "r") as f:
