@@ -1093,22 +1093,38 @@ def descendants(pid):
     return found
 
 
-def test_a_sweep_whose_jobs_get_sigterm_exits_143(tmp_path):
-    """A scheduler that sends SIGTERM to the workers of a sweep, not to the command: each job
-    ends as terminated, and the command says so with status 143."""
-    process = start(*FOREVER, "seed=0,1", "hydra.sweep.dir=S", "-m", cwd=tmp_path)
+@pytest.mark.parametrize("to, how, seeds", [("the workers", signal.SIGTERM, "0,1"),
+                                             ("the process group", signal.SIGINT, "0,1"),
+                                             ("the command", signal.SIGTERM, "0,1,2")])
+def test_a_signal_stops_a_sweep_whole(to, how, seeds, tmp_path):
+    """However a signal reaches a sweep (a scheduler signals the workers, Ctrl-C the process
+    group, kill the command): every running job ends with its final snapshot and checkpoint,
+    a job not begun runs nothing, and the command exits 128 + the signal's number, its
+    workers gone and no stop file left."""
+    process = start(*FOREVER, f"seed={seeds}", "hydra.sweep.dir=S", "-m", cwd=tmp_path,
+                    start_new_session=True)
     try:
         for job in ("0", "1"):
             assert wait_for(tmp_path / "S" / job / "run.h5", process), finish(process).err
     finally:
-        for pid in descendants(process.pid):
+        workers = descendants(process.pid)
+        if to == "the process group":
+            os.killpg(process.pid, how)
+        for pid in workers if to == "the workers" else [process.pid] * (to == "the command"):
             try:
-                os.kill(pid, signal.SIGTERM)
+                os.kill(pid, how)
             except ProcessLookupError:
                 pass
         result = finish(process)
-    check(result, 143, ["terminated", "hydra.sweep.dir=S"])
-    assert {stop_reason(tmp_path / "S" / job / "run.h5") for job in "01"} == {"terminated"}
+    reason = "terminated" if how == signal.SIGTERM else "interrupted"
+    check(result, 128 + how, [reason, "hydra.sweep.dir=S"])
+    assert {stop_reason(tmp_path / "S" / job / "run.h5") for job in "01"} == {reason}
+    summary_ = yaml.safe_load((tmp_path / "S" / "sweep_summary.yaml").read_text())
+    assert summary_["stopped"] == len(seeds.split(",")) and summary_["failed"] == 0
+    assert not (tmp_path / "S" / "2" / "run.h5").exists()  # begun after the stop: nothing
+    assert not (tmp_path / "S" / ".sweep-stop").exists()
+    assert not [pid for pid in workers if Path(f"/proc/{pid}").exists()
+                and "Z" not in Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2][:3]]
 
 
 #: ``python -m sim`` that sends itself SIGINT at a moment of its start-up, the first argument:

@@ -4,7 +4,7 @@ Each job writes ``<job dir>/job_status.yaml`` (overrides, status, run file or er
 end of the sweep ``<sweep dir>/sweep_summary.yaml`` lists them all. A failing job does not
 stop the others: in a sweep the job function returns ``{"failed": message}`` instead of
 raising, so the launcher runs every job and the entry point exits with status 1 at the end
-when any failed.
+when any failed. A job a signal stopped returns ``{"stopped": reason}``: status STOPPED.
 """
 
 from pathlib import Path
@@ -16,6 +16,8 @@ from hydra.experimental.callback import Callback
 from hydra.types import RunMode
 
 STATUS_FILE = "job_status.yaml"
+#: the status of a job a signal stopped (its run file resumes; :mod:`sim.pipeline.sweep_stop`)
+STOPPED = "STOPPED"
 SUMMARY_FILE = "sweep_summary.yaml"
 #: Jobs of the last sweep in this process that failed (read by ``python -m sim``).
 FAILED_JOBS = []
@@ -32,6 +34,9 @@ class SweepReport(Callback):
         value = job_return._return_value
         if job_return.status == JobStatus.COMPLETED and not isinstance(value, dict):
             entry["run_file"] = str(value)
+        elif isinstance(value, dict) and "stopped" in value:  # sim.pipeline.sweep_stop
+            entry["status"] = STOPPED
+            entry["stop_reason"] = value["stopped"]
         else:
             entry["status"] = JobStatus.FAILED.name
             entry["error"] = (value["failed"] if isinstance(value, dict)
@@ -43,9 +48,10 @@ class SweepReport(Callback):
         sweep_dir = Path(config.hydra.sweep.dir)
         jobs = [yaml.safe_load(p.read_text()) for p in sorted(sweep_dir.glob(f"*/{STATUS_FILE}"))]
         jobs.sort(key=lambda job: job["job"])
-        failed = [job for job in jobs if job["status"] != "COMPLETED"]
-        summary = {"jobs": len(jobs), "completed": len(jobs) - len(failed),
-                   "failed": len(failed), "details": jobs}
+        failed = [job for job in jobs if job["status"] not in ("COMPLETED", STOPPED)]
+        stopped = [job for job in jobs if job["status"] == STOPPED]
+        summary = {"jobs": len(jobs), "completed": len(jobs) - len(failed) - len(stopped),
+                   "failed": len(failed), "stopped": len(stopped), "details": jobs}
         text = yaml.safe_dump(summary, sort_keys=False, allow_unicode=True)
         (sweep_dir / SUMMARY_FILE).write_text(text)
         FAILED_JOBS[:] = failed

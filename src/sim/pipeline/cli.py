@@ -36,11 +36,10 @@ from hydra.types import RunMode
 
 from sim.__main__ import leave
 from sim.engine.errors import PhysicsBreakdown
-from sim.pipeline import callbacks
+from sim.pipeline import callbacks, cli_exits, sweep_stop
 from sim.pipeline.cli_exits import (
     EXIT_BREAKDOWN,
     EXIT_RUN_FILE,
-    Stopped,
     fail,
     quiet_hdf5_teardown,
     quiet_hdf5_traceback,
@@ -48,7 +47,7 @@ from sim.pipeline.cli_exits import (
     report_passed_over,
     stop_at_once,
     stopped,
-    stopped_in_a_job,
+    stopped_by,
     stopped_status,
     terminate,
     warn_in_one_line,
@@ -67,6 +66,7 @@ from sim.pipeline.preflight import (
     check_command_line,
     check_resources,
     check_sweep_folder,
+    joblib_workers,
     run_folder,
 )
 from sim.pipeline.resume import resume
@@ -83,9 +83,22 @@ register()
 @hydra.main(config_path=CONF_DIR, config_name="config", version_base="1.3")
 def hydra_main(cfg):
     """One job: run or resume it and say what the run file holds; in a sweep a failing job
-    returns ``{"failed": message}`` (:mod:`sim.pipeline.callbacks`)."""
+    returns ``{"failed": message}`` (:mod:`sim.pipeline.callbacks`), one a signal stopped
+    ``{"stopped": reason}`` (:mod:`sim.pipeline.sweep_stop`)."""
     sweeping = HydraConfig.get().mode == RunMode.MULTIRUN
     output_dir = HydraConfig.get().runtime.output_dir
+    if sweeping:
+        Interruption.sweep_dir = HydraConfig.get().sweep.dir
+        with sweep_stop.job(Interruption.sweep_dir, stop_at_once):
+            asked = sweep_stop.requested(Interruption.sweep_dir)
+            if asked is not None:  # the sweep was stopped before this job began
+                return {"stopped": Interruption.REASONS[asked]}
+            return _job(cfg, sweeping, output_dir)
+    return _job(cfg, sweeping, output_dir)
+
+
+def _job(cfg, sweeping, output_dir):
+    """:func:`hydra_main`'s job, in its folder ``output_dir``."""
     overrides = list(HydraConfig.get().overrides.task)
     path = Path(cfg.resume) if cfg.resume is not None else Path(output_dir) / cfg.output.file
     try:
@@ -111,7 +124,7 @@ def hydra_main(cfg):
         return {"failed": f"{type(error).__name__}: {error}"}
     except KeyboardInterrupt:
         if sweeping:
-            raise Stopped() from None
+            return _stop_the_sweep(stopped())
         where = (f"the run file {path} keeps what was written; continue with: python -m sim "
                  f"resume={path}" if path.exists() else "nothing was written")
         remove_made_folders()
@@ -131,11 +144,18 @@ def hydra_main(cfg):
           f"error {info['energy_drift']:.1e}), stop reason: {info['stop_reason']}\n"
           f"run file: {path}", flush=True)
     if info["stop_reason"] in ("interrupted", "terminated"):
-        if sweeping:  # a signal stops the whole sweep, not one job
-            raise Stopped(signal.SIGTERM if info["stop_reason"] == "terminated"
-                          else signal.SIGINT)
+        if sweeping:
+            return _stop_the_sweep(info["stop_reason"])
         INTERRUPTED.append((path, info["stop_reason"]))
     return str(path)
+
+
+def _stop_the_sweep(reason):
+    """A job a signal stopped (``reason``: interrupted or terminated) stops its whole sweep,
+    and returns so that the launcher waits for the others to end."""
+    signum = signal.SIGTERM if reason == "terminated" else signal.SIGINT
+    sweep_stop.request(HydraConfig.get().sweep.dir, signum)
+    return {"stopped": reason}
 
 
 def main():
@@ -158,6 +178,11 @@ def main():
             check_resources(args, configs)
         if sweeping and value_of(args, "hydra.sweep.dir") is not None:
             check_sweep_folder(args, configs)
+        if sweeping:
+            args = joblib_workers(args, len(configs))
+            sweep_dir = value_of(args, "hydra.sweep.dir")
+            sweep_stop.clear(sweep_dir)  # left by a sweep killed there before
+            sweep_stop.guard_sweep(sweep_dir, stopped_by, stop_at_once)
         sys.argv[1:] = flags_last(args)
         try:
             hydra_main()
@@ -165,8 +190,7 @@ def main():
             if stop.code not in (0, None):
                 remove_made_folders()  # those still empty: a refusal leaves none behind
             raise
-    except KeyboardInterrupt as stop:
-        stopped_in_a_job(stop)
+    except KeyboardInterrupt:
         remove_made_folders()
         if sweeping:
             folder = value_of(args, "hydra.sweep.dir")
@@ -174,6 +198,13 @@ def main():
                   f"continues its jobs", stopped_status())
         leave(f"sim: {stopped()} before the run started; nothing was written",
               stopped_status())
+    if sweeping and (asked := sweep_stop.requested(sweep_dir)) is not None:
+        sweep_stop.clear(sweep_dir)
+        if len(cli_exits.STOPPED_BY) == 1:  # the signal came to a worker, not here
+            stopped_by(asked)
+        print(f"sim: sweep {stopped()}; the same command with hydra.sweep.dir={sweep_dir} "
+              f"continues its jobs", file=sys.stderr)
+        sys.exit(stopped_status())  # atexit ends joblib's workers
     if callbacks.FAILED_JOBS:
         sys.exit(EXIT_RUN_FILE)
     if INTERRUPTED:

@@ -49,29 +49,13 @@ def first_line(error):
     return lines[0] if lines else type(error).__name__
 
 
-class Stopped(KeyboardInterrupt):
-    """A job of a sweep stopped by the signal ``signum`` (by default the last one this process
-    took): raised in the job's worker, it reaches the sweep's process (joblib raises a
-    worker's exception there again), which ends with that signal's status when no signal
-    came to it directly."""
-
-    def __init__(self, signum=None):
-        self.signum = signal.Signals(STOPPED_BY[-1] if signum is None else signum)
-        super().__init__(self.signum.name)
-
-    def __reduce__(self):
-        return type(self), (int(self.signum),)
-
-
-def stopped_in_a_job(stop):
-    """Take the signal that stopped a job of the sweep (``stop``, an exception) as the
-    command's, unless one came to this process."""
-    if isinstance(stop, Stopped) and len(STOPPED_BY) == 1:
-        STOPPED_BY.append(stop.signum)
+def stopped_by(signum):
+    """Take ``signum`` as the signal that stopped the command."""
+    STOPPED_BY.append(signal.Signals(signum))
 
 
 def terminate(signum, frame):
-    STOPPED_BY.append(signal.Signals(signum))
+    stopped_by(signum)
     raise KeyboardInterrupt
 
 

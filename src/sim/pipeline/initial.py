@@ -12,7 +12,11 @@
   :func:`maxwellian` (components drawn from N(0, T/m)); :func:`remove_drift` zeroes the total
   momentum.
 
-Positions are float64[n, 2] in box units; regions are ((x0, x1), (y0, y1)).
+Positions are float64[n, 2] in box units. Every argument is checked before any work, a bad
+one a ValueError naming it: ``box`` two finite sides (Lx, Ly) > 0, ``region`` ((x0, x1),
+(y0, y1)) inside the box with x0 < x1, y0 < y1 (default: the box), ``periodic`` a bool or a
+pair (x, y) of them, ``seed`` a whole number from 0 to 2^64 − 1 (the command line's seed,
+at most 2^63 − 1, and the next ones it draws velocities and species with).
 """
 
 import math
@@ -20,10 +24,24 @@ import math
 import numpy as np
 from numba import njit
 
-from sim.engine.inputs import real_array, real_number, whole_count
+from sim.engine.inputs import (
+    box_sides,
+    periodic_pair,
+    real_array,
+    real_number,
+    refused,
+    whole_count,
+)
 from sim.pipeline.input_checks import MAX_DISKS
 
 RSA_JAMMING = 0.547
+
+#: Largest seed of the helpers here: numpy seeds a generator with any whole number ≥ 0; one
+#: 64-bit word holds the command line's seed and the next ones its scenes draw with.
+MAX_HELPER_SEED = 2**64 - 1
+
+#: Most attempts :func:`random_sequential` may make to place one disk.
+MAX_ATTEMPTS = 10**9
 
 
 def _count(call, n):
@@ -32,9 +50,27 @@ def _count(call, n):
 
 
 def _radii(call, radius):
-    """The radii of ``call`` (a number or an array), each finite and > 0."""
-    return real_array(call, "radius", radius, lambda r: (r > 0.0) & (r < math.inf),
-                      "radii finite and > 0")
+    """The radii of ``call`` (a number or a 1-D array of one or more) as float64[k], each
+    finite and > 0."""
+    radii = real_array(call, "radius", radius, lambda r: (r > 0.0) & (r < math.inf),
+                       "radii finite and > 0")
+    if radii.ndim > 1 or radii.size == 0:
+        raise refused(call, "radius", radius, "a radius, or a 1-D array of one or more")
+    return np.atleast_1d(radii)
+
+
+def _lattice_radii(call, n, radius):
+    """:func:`_radii` of ``call``, one radius or one for each of the ``n`` disks."""
+    radii = _radii(call, radius)
+    if radii.size not in (1, n):
+        raise refused(call, "radius", radius, f"one radius, or one for each of the n = {n} "
+                                              f"disks")
+    return radii
+
+
+def _seed(call, seed):
+    """The ``seed`` of ``call`` as an int from 0 to :data:`MAX_HELPER_SEED`."""
+    return whole_count(call, "seed", seed, high=MAX_HELPER_SEED)
 
 
 class PlacementError(ValueError):
@@ -121,26 +157,60 @@ def radius_for_packing(n, packing_fraction, area=1.0):
     return float(np.sqrt(packing_fraction * area / (n * np.pi)))
 
 
-def _region(region, box):
+def _region(call, region, box):
+    """The corners (x0, y0), (x1, y1) float64[2] of ``region`` ((x0, x1), (y0, y1)) of
+    ``call``, finite, 0 ≤ x0 < x1 ≤ Lx and 0 ≤ y0 < y1 ≤ Ly (the box sides ``box``); the
+    whole box when None."""
     if region is None:
-        region = ((0.0, box[0]), (0.0, box[1]))
-    (x0, x1), (y0, y1) = region
-    return np.array([x0, y0], float), np.array([x1, y1], float)
+        return np.zeros(2), np.array(box, float)
+    try:
+        bounds = real_array(call, "region", region)
+    except ValueError:
+        bounds = None
+    if (bounds is None or bounds.shape != (2, 2)
+            or not np.all((0.0 <= bounds[:, 0]) & (bounds[:, 0] < bounds[:, 1])
+                          & (bounds[:, 1] <= box))):
+        raise refused(call, "region", region, f"((x0, x1), (y0, y1)) inside the box: 0 ≤ x0 < "
+                      f"x1 ≤ {box[0]:g}, 0 ≤ y0 < y1 ≤ {box[1]:g}", show=True)
+    return bounds[:, 0].copy(), bounds[:, 1].copy()
+
+
+def _layout(call, radius, box, region, periodic):
+    """The checked ``box``, corners of ``region`` (:func:`_region`) and ``periodic`` of
+    ``call``, and which axes wrap (periodic and spanned by the region); a
+    :class:`PlacementError` naming ``radius`` when the widest disk is not narrower than the
+    region along an axis."""
+    box = box_sides(call, "box", box)
+    lo, hi = _region(call, region, box)
+    periodic = periodic_pair(call, "periodic", periodic)
+    wraps = tuple(periodic[a] and lo[a] == 0.0 and hi[a] == box[a] for a in range(2))
+    widest = 2.0 * float(np.max(radius))
+    for axis in range(2):
+        if widest >= hi[axis] - lo[axis]:
+            raise PlacementError(str(refused(
+                call, "radius", radius,
+                f"disks narrower than the region: a diameter {widest:g} does not fit in its "
+                f"side {hi[axis] - lo[axis]:g} along {'xy'[axis]} (the box's unless region "
+                f"is given)")))
+    return box, lo, hi, wraps
 
 
 def random_sequential(radius, box=(1.0, 1.0), region=None, periodic=(False, False), seed=0,
                       max_attempts=20_000):
-    """Place disks of the given radii (largest first) uniformly at random without overlap.
+    """Place disks of the given radii (a number or a 1-D array; largest first) uniformly at
+    random without overlap, each diameter less than the region's sides; ``max_attempts``
+    per disk, whole from 1 to :data:`MAX_ATTEMPTS`.
 
     Raises :class:`PlacementError` with the packing reached when a disk finds no room.
     """
-    radius = np.atleast_1d(_radii("random_sequential", radius))
-    lo, hi = _region(region, box)
-    periodic_region = np.array([periodic[a] and lo[a] == 0.0 and hi[a] == box[a]
-                                for a in range(2)])
+    call = "random_sequential"
+    radius = _radii(call, radius)
+    box, lo, hi, wraps = _layout(call, radius, box, region, periodic)
+    seed = _seed(call, seed)
+    max_attempts = whole_count(call, "max_attempts", max_attempts, low=1, high=MAX_ATTEMPTS)
     order = np.argsort(-radius, kind="stable")
-    placed, failed = _rsa(radius[order], lo, hi, np.asarray(box, float), periodic_region,
-                          np.random.default_rng(seed), int(max_attempts))
+    placed, failed = _rsa(radius[order], lo, hi, box, np.array(wraps),
+                          np.random.default_rng(seed), max_attempts)
     if failed >= 0:
         area = float(np.prod(hi - lo))
         reached = float(np.pi * np.sum(radius[order][:failed] ** 2) / area)
@@ -162,17 +232,17 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
 
     On a periodic axis spanning the whole box the lattice wraps around (an even number of
     rows along y); along walls the outermost centres stay a radius from the wall.
-    ``radius`` may be an array; the lattice is spaced for the largest disk.
+    ``radius`` may be an array (one radius or n); the lattice is spaced for the largest disk.
     """
-    n = _count("hexagonal_lattice", n)
-    r_max = float(np.max(_radii("hexagonal_lattice", radius)))
-    real_number("hexagonal_lattice", "jitter", jitter, lambda j: 0.0 <= j <= 1.0,
+    call = "hexagonal_lattice"
+    n = _count(call, n)
+    radii = _lattice_radii(call, n, radius)
+    r_max = float(np.max(radii))
+    box, lo, hi, wraps = _layout(call, radii, box, region, periodic)
+    real_number(call, "jitter", jitter, lambda j: 0.0 <= j <= 1.0,
                 "a fraction of half the gap in [0, 1]")
-    lo, hi = _region(region, box)
-    wraps = [bool(periodic[a]) and lo[a] == 0.0 and hi[a] == box[a] for a in range(2)]
+    seed = _seed(call, seed)
     width, height = (hi - lo) - np.where(wraps, 0.0, 2.0 * r_max)
-    if width < 0 or height < 0:
-        raise PlacementError("region is narrower than one disk")
     best = None
     for columns in range(1, n + 1):
         rows = math.ceil(n / columns)
@@ -214,13 +284,17 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
     position += step[:, None] * np.stack([np.cos(angle), np.sin(angle)], axis=1)
     # a clipped coordinate moves the disk back towards its site: still no overlap
     clipped = np.clip(position, lo + r_max, hi - r_max)
-    return np.where(wraps, position % np.asarray(box, float), clipped)
+    return np.where(wraps, position % box, clipped)
 
 
 #: Collisions per disk of the elastic run that melts a lattice (:func:`melted_lattice`):
 #: tests/test_initial.py checks that the crater bed's global bond-orientational order |ψ₆|
 #: (0.9 on the lattice) is then a fluid's, below 3/√n.
 MELT_COLLISIONS_PER_DISK = 10
+
+#: Most collisions per disk a melt may be asked for (:func:`melted_lattice`): a thousand
+#: times the default, and a bound on its run.
+MAX_MELT_COLLISIONS_PER_DISK = 10**4
 
 #: the stream of random numbers of a melt's velocities, apart from the scene's own
 MELT_STREAM = 7
@@ -230,22 +304,32 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
                    collisions_per_disk=MELT_COLLISIONS_PER_DISK):
     """Positions float64[n, 2] of n disks placed on :func:`hexagonal_lattice` and melted by
     an elastic run confined to the region (Maxwellian velocities at T = 1, zero momentum,
-    ``collisions_per_disk`` × n disk–disk collisions): hard walls at the region's edges,
-    periodic along an axis the region spans in a periodic box. Deterministic in ``seed``."""
+    ``collisions_per_disk`` × n disk–disk collisions, ``collisions_per_disk`` from 0 to
+    :data:`MAX_MELT_COLLISIONS_PER_DISK`): hard walls at the region's edges, periodic along
+    an axis the region spans in a periodic box. One disk, which has nothing to collide
+    with, stays on its site. Deterministic in ``seed``."""
     from sim.engine.core import Engine
     from sim.engine.inputs import Boundary  # the engine prepares, it does not place
 
-    lo, hi = _region(region, box)
-    wraps = tuple(bool(periodic[a]) and lo[a] == 0.0 and hi[a] == box[a] for a in range(2))
+    call = "melted_lattice"
+    collisions_per_disk = real_number(
+        call, "collisions_per_disk", collisions_per_disk,
+        lambda c: 0.0 <= c <= MAX_MELT_COLLISIONS_PER_DISK,
+        f"a number of collisions per disk from 0 to {MAX_MELT_COLLISIONS_PER_DISK}")
+    n = _count(call, n)
+    _, lo, hi, wraps = _layout(call, _lattice_radii(call, n, radius), box, region, periodic)
+    seed = _seed(call, seed)
     position = hexagonal_lattice(n, radius, box=box, region=region, periodic=periodic, seed=seed)
+    if n == 1:
+        return position
     mass = np.ones(n)
-    streams = np.random.SeedSequence((seed, MELT_STREAM))
-    velocity = remove_drift(maxwellian(mass, 1.0, seed=streams), mass)
+    rng = np.random.default_rng(np.random.SeedSequence((seed, MELT_STREAM)))
+    velocity = remove_drift(_gaussian(mass, 1.0, rng), mass)
     collisions = round(collisions_per_disk * n)
     try:
         engine = Engine(position - lo, velocity, radius, mass,
                         boundary=Boundary(size=tuple(float(x) for x in hi - lo),
-                                          periodic=wraps), seed=seed)
+                                          periodic=wraps))
         reason = engine.run(collisions=collisions)
     except ValueError as error:
         raise PlacementError(f"the lattice could not be melted: {error}") from error
@@ -257,25 +341,48 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
 
 
 def fixed_speed(n, speed, seed=0):
-    """Velocities of equal magnitude ``speed`` in uniformly random directions: float64[n, 2]."""
+    """Velocities of equal magnitude ``speed`` (finite, ≥ 0) in uniformly random directions:
+    float64[n, 2]."""
     n = _count("fixed_speed", n)
     speed = real_number("fixed_speed", "speed", speed, lambda v: 0.0 <= v < math.inf,
                         "a finite speed ≥ 0")
-    angle = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi, n)
+    angle = np.random.default_rng(_seed("fixed_speed", seed)).uniform(0.0, 2.0 * np.pi, n)
     return speed * np.stack([np.cos(angle), np.sin(angle)], axis=1)
 
 
+def _masses(call, mass, n=None):
+    """The masses of ``call`` (a number, or a 1-D array of one or more, or of ``n`` when
+    given) as float64[k], each finite and > 0."""
+    masses = real_array(call, "mass", mass, lambda m: (m > 0.0) & (m < math.inf),
+                        "masses finite and > 0")
+    if masses.ndim > 1 or masses.size == 0 or (n is not None and masses.size not in (1, n)):
+        count = "one or more" if n is None else f"one for each of the n = {n} disks"
+        raise refused(call, "mass", mass, f"a mass, or a 1-D array of masses ({count})")
+    return np.atleast_1d(masses)
+
+
 def maxwellian(mass, temperature, seed=0):
-    """Velocities with components drawn from N(0, T/m) (k_B = 1): float64[n, 2]."""
-    mass = np.atleast_1d(real_array("maxwellian", "mass", mass,
-                                    lambda m: (m > 0.0) & (m < math.inf), "masses finite and > 0"))
+    """Velocities with components drawn from N(0, T/m) (k_B = 1): float64[n, 2] for the n
+    masses ``mass`` (a number or a 1-D array, each finite and > 0), ``temperature`` finite
+    and ≥ 0."""
+    mass = _masses("maxwellian", mass)
     temperature = real_number("maxwellian", "temperature", temperature,
                               lambda t: 0.0 <= t < math.inf, "a finite temperature ≥ 0")
-    scale = np.sqrt(temperature / mass)
-    return np.random.default_rng(seed).normal(size=(mass.size, 2)) * scale[:, None]
+    return _gaussian(mass, temperature, np.random.default_rng(_seed("maxwellian", seed)))
+
+
+def _gaussian(mass, temperature, rng):
+    """:func:`maxwellian` of checked values, drawn from the generator ``rng``."""
+    return rng.normal(size=(mass.size, 2)) * np.sqrt(temperature / mass)[:, None]
 
 
 def remove_drift(velocity, mass):
-    """Subtract the centre-of-mass velocity so that the total momentum is zero."""
-    mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (velocity.shape[0],))
+    """``velocity`` (n, 2), finite, less the centre-of-mass velocity of the disks of masses
+    ``mass`` (a number or n, each finite and > 0): float64[n, 2] of zero total momentum."""
+    velocity = real_array("remove_drift", "velocity", velocity, np.isfinite,
+                          "velocities finite")
+    if velocity.ndim != 2 or velocity.shape[1:] != (2,) or velocity.shape[0] == 0:
+        raise refused("remove_drift", "velocity", velocity, "an array (n, 2) with n ≥ 1")
+    mass = np.broadcast_to(_masses("remove_drift", mass, velocity.shape[0]),
+                           (velocity.shape[0],))
     return velocity - (mass[:, None] * velocity).sum(axis=0) / mass.sum()

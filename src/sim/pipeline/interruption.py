@@ -3,18 +3,25 @@
 import signal
 import threading
 
+from sim.pipeline import sweep_stop
+
 
 class Interruption:
     """SIGINT (Ctrl-C) or SIGTERM (a batch scheduler's time limit) asks the run to stop: the
     engine finishes its compiled chunk, the runner writes a final snapshot and checkpoint,
     and the run ends with stop reason ``interrupted`` or ``terminated`` (``resume``
-    continues it). A second signal acts at once: :attr:`at_second_signal` (the command line
-    leaves the process there, as SIGKILL would; by default a KeyboardInterrupt is raised).
-    Installed only in the main thread, and only for the run."""
+    continues it); in a sweep, so does the sweep's stop file (:attr:`sweep_dir`). A second
+    signal acts at once: :attr:`at_second_signal` (the command line leaves the process
+    there, as SIGKILL would; by default a KeyboardInterrupt is raised). Installed only in
+    the main thread, and only for the run."""
 
     REASONS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
     #: ``f(signal)`` called at a second signal; None: raise KeyboardInterrupt
     at_second_signal = None
+    #: the folder of the sweep this process runs a job of: its stop file
+    #: (:mod:`sim.pipeline.sweep_stop`) asks the run to stop as a signal would; None outside
+    #: a sweep
+    sweep_dir = None
 
     def __init__(self):
         self.signal = None
@@ -22,6 +29,8 @@ class Interruption:
 
     @property
     def requested(self):
+        if self.signal is None and Interruption.sweep_dir is not None:
+            self.signal = sweep_stop.requested(Interruption.sweep_dir)
         return self.signal is not None
 
     @property

@@ -10,7 +10,7 @@ from omegaconf import OmegaConf
 from omegaconf.errors import KeyValidationError, ValidationError
 
 from sim.__main__ import caused_by_a_signal
-from sim.pipeline import cli_exits, resources
+from sim.pipeline import cli_exits, resources, sweep_stop
 from sim.pipeline.cli_exits import EXIT_RUN_FILE, fail, first_line, make_folder
 from sim.pipeline.config import ConfigError, validate
 from sim.pipeline.overrides import (
@@ -174,6 +174,19 @@ def check_resources(args, configs):
         fail(str(error))
     for cfg in fresh:
         resources.warn_large(cfg)
+
+
+def joblib_workers(args, jobs):
+    """The command line of a sweep of ``jobs`` jobs with the joblib launcher's ``n_jobs`` set
+    to no more workers than jobs, unless the command line sets it
+    (:func:`sim.pipeline.sweep_stop.worker_count`)."""
+    launcher = hydra_settings(args).hydra.launcher
+    if not str(launcher.get("_target_", "")).endswith("JoblibLauncher") \
+            or value_of(args, "hydra.launcher.n_jobs") is not None:
+        return args
+    n_jobs = int(launcher.n_jobs) if launcher.get("n_jobs") is not None else -1
+    return with_value(args, "hydra.launcher.n_jobs",
+                      sweep_stop.worker_count(n_jobs, jobs, os.cpu_count() or 1))
 
 
 def check_sweep_folder(args, configs):

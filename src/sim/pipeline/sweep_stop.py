@@ -1,0 +1,122 @@
+"""A sweep stopped by a signal as a whole: every running job ends with its final snapshot and
+checkpoint, and no job starts after.
+
+SIGINT or SIGTERM to the sweep's process (``python -m sim … -m``), to a worker that runs its
+jobs, or to all of them at once (Ctrl-C in a terminal, a scheduler's time limit) writes the
+signal's name into the stop file :data:`STOP_FILE` of the sweep folder (:func:`request`). A
+running job watches for it between compiled chunks as for a signal of its own
+(:attr:`sim.pipeline.interruption.Interruption.stop_file`) and ends as ``interrupted`` or
+``terminated``; a job that starts after it runs nothing. Stopped jobs return, not raise, so
+that the launcher waits for the others (joblib ends a pool at a job's exception, killing the
+jobs still writing); the sweep's process then exits with 128 + the signal's number, and
+clears the stop file (:func:`clear`), as does the next sweep into the folder. A second
+signal stops at once, as SIGKILL would.
+
+The sweep's process blocks both signals before its workers start and takes them in a thread
+of its own (:func:`guard_sweep`): workers inherit them blocked, and a job unblocks them while
+it runs (:func:`job`), so that a signal to a worker between two jobs neither kills it (which
+would break joblib's pool, killing the jobs still writing) nor is lost. The launcher starts
+no more workers than jobs (:func:`worker_count`).
+"""
+
+import os
+import signal
+import threading
+from contextlib import contextmanager
+from pathlib import Path
+
+#: the stop file, in the sweep folder
+STOP_FILE = ".sweep-stop"
+
+
+def stop_file(sweep_dir):
+    return Path(sweep_dir) / STOP_FILE
+
+
+def request(sweep_dir, signum):
+    """Ask every job of the sweep in ``sweep_dir`` to stop, for the signal ``signum`` (the
+    first one asked for is kept)."""
+    try:
+        fd = os.open(stop_file(sweep_dir), os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+    except FileExistsError:
+        return
+    with os.fdopen(fd, "w") as out:
+        out.write(signal.Signals(signum).name)
+
+
+def requested(sweep_dir):
+    """The signal the sweep in ``sweep_dir`` was asked to stop for, or None."""
+    try:
+        name = stop_file(sweep_dir).read_text().strip()
+    except FileNotFoundError:
+        return None
+    return signal.Signals[name] if name in signal.Signals.__members__ else signal.SIGINT
+
+
+def clear(sweep_dir):
+    stop_file(sweep_dir).unlink(missing_ok=True)
+
+
+#: the signals that stop a sweep
+SIGNALS = {signal.SIGINT, signal.SIGTERM}
+
+
+def guard_sweep(sweep_dir, taken, at_second_signal):
+    """In the sweep's process, before its workers start: the first SIGINT or SIGTERM is
+    ``taken(signal)`` and :func:`request`, a second ``at_second_signal(signal)``. Both
+    signals are blocked in this thread, so that the threads it starts and the workers they
+    spawn inherit them blocked (a worker between jobs then outlives a signal to its process
+    group); a thread of their own waits for them, and the handler takes those that reach
+    threads started before."""
+    count = []
+
+    def take(signum):
+        if count:
+            at_second_signal(signal.Signals(signum))
+        count.append(signum)
+        taken(signal.Signals(signum))
+        request(sweep_dir, signum)
+
+    for number in SIGNALS:
+        signal.signal(number, lambda signum, frame: take(signum))
+    signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+
+    def wait():
+        while True:
+            take(signal.sigwait(SIGNALS))
+
+    threading.Thread(target=wait, name="sweep signals", daemon=True).start()
+
+
+@contextmanager
+def job(sweep_dir, at_second_signal):
+    """A job of the sweep in ``sweep_dir``, in a worker: SIGINT and SIGTERM, blocked between
+    jobs, reach it inside the block and ask the sweep to stop (:func:`request`; the run's
+    :class:`sim.pipeline.interruption.Interruption` takes them while it runs); a second one
+    to this process is ``at_second_signal(signal)``."""
+    taken = []
+
+    def handler(signum, frame):
+        if taken:
+            at_second_signal(signal.Signals(signum))
+        taken.append(signum)
+        request(sweep_dir, signum)
+
+    main = threading.current_thread() is threading.main_thread()
+    if main:
+        previous = {number: signal.signal(number, handler) for number in SIGNALS}
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
+    try:
+        yield
+    finally:
+        if main:
+            signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+            for number, handling in previous.items():
+                signal.signal(number, handling)
+
+
+def worker_count(n_jobs, jobs, cores):
+    """Workers for ``jobs`` jobs with joblib's ``n_jobs`` (negative: cores + 1 + n_jobs) on
+    ``cores`` cores: never more than the jobs."""
+    wanted = cores + 1 + n_jobs if n_jobs < 0 else n_jobs
+    return max(1, min(jobs, wanted))
