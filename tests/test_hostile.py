@@ -31,6 +31,7 @@ import yaml
 
 from sim.pipeline import runner
 from sim.pipeline.config import ConfigError
+from sim.pipeline.run_cache import compose_config
 from sim.storage.inspect import summary
 
 PY = sys.executable
@@ -440,8 +441,6 @@ def test_a_run_that_cannot_be_made_is_refused_before_anything_is_written(case, t
     """In the process: the runner builds the scene and weighs its stop conditions before it
     writes anything, and raises the ConfigError the command line prints as its one line."""
     from sim.pipeline.config import ConfigError
-    from sim.pipeline.run_cache import compose_config
-
     command, key = NEVER[case]
     folder = tmp_path / "run"
     folder.mkdir()
@@ -558,8 +557,6 @@ def test_a_named_pipe_as_the_run_file_of_a_new_run_is_refused(entry, tmp_path):
     (tmp_path / "X").mkdir()
     os.mkfifo(tmp_path / "X" / "run.h5")
     before = tree(tmp_path)
-    from sim.pipeline.run_cache import compose_config
-
     with pytest.raises(ConfigError, match="not a regular file"):
         runner.run(compose_config([*SMALL, QUIET]), tmp_path / "X")
     assert tree(tmp_path) == before
@@ -669,6 +666,46 @@ def test_a_stored_config_is_read_as_data_never_resolved(key, entry, small_run, t
     result = entry(f"resume={good}", "stop.collisions=4000")
     check(result, 2, ["resume", "${oc.env:MY_VALUE}"], before, tree(tmp_path),
           nothing_new=True)
+
+
+def test_resume_falls_back_when_the_latest_checkpoint_slot_is_gone(small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    with h5py.File(good, "r+") as f:
+        del f["checkpoint"][str(f["checkpoint"].attrs["latest"])]
+        f["parameters"].attrs["stop_reason"] = "interrupted"
+    with pytest.warns(RuntimeWarning, match="is damaged; resuming from slot"), \
+            pytest.warns(RuntimeWarning, match="snapshots written after it"):
+        runner.resume(good)
+    assert summary(good)["stop_reason"] == "collisions" and summary(good)["damaged"] == []
+
+
+def test_resume_may_repeat_a_stored_value(small_run, tmp_path):
+    """``disks.n=200`` on a file of 200 disks changes nothing: not refused."""
+    good = copy_run(small_run, tmp_path)
+    runner.resume(good, ["stop.collisions=3000", "disks.n=200", "seed=0"])
+    assert summary(good)["collisions"] == 3000
+    with pytest.raises(ConfigError, match="disks.n.*unchanged on resume"):
+        runner.resume(good, ["stop.collisions=4000", "disks.n=300"])
+
+
+def test_a_stored_value_of_the_wrong_type_is_one_plain_line(entry, small_run, tmp_path):
+    good = copy_run(small_run, tmp_path)
+    with h5py.File(good, "r+") as f:
+        config = yaml.safe_load(str(f["parameters"].attrs["config"]))
+        config["disks"]["n"] = "two hundred"
+        f["parameters"].attrs["config"] = yaml.safe_dump(config)
+    result = entry(f"resume={good}", "stop.collisions=4000")
+    check(result, 2, ["resume", "two hundred"])
+    assert "object_type" not in result.err and "reference_type" not in result.err
+
+
+def test_a_run_folder_whose_run_file_has_no_checkpoint_is_named_as_a_folder(small_run,
+                                                                            tmp_path):
+    good = copy_run(small_run, tmp_path)
+    _no_checkpoint(good)
+    with pytest.raises(ConfigError) as refused:
+        runner.run(compose_config([*SMALL, QUIET]), good.parent, folder_key="hydra.run.dir")
+    assert refused.value.key == "hydra.run.dir" and refused.value.value == str(good.parent)
 
 
 def test_resume_after_a_kill_says_which_snapshots_it_computes_again(small_run, tmp_path):

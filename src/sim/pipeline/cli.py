@@ -87,6 +87,7 @@ def hydra_main(cfg):
     ``{"stopped": reason}`` (:mod:`sim.pipeline.sweep_stop`)."""
     sweeping = HydraConfig.get().mode == RunMode.MULTIRUN
     output_dir = HydraConfig.get().runtime.output_dir
+    warnings.showwarning = warn_in_one_line  # also in a sweep's workers
     if sweeping:
         Interruption.sweep_dir = HydraConfig.get().sweep.dir
         with sweep_stop.job(Interruption.sweep_dir, stop_at_once):

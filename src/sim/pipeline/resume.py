@@ -104,8 +104,10 @@ def stored_config(path, key="resume"):
     except RunFileError as error:
         raise ConfigError(key, str(path), f"a readable run file: {error}") from error
     except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
+        # the first line: OmegaConf's errors go on with the context of the failing key
+        reason = (str(error).strip().splitlines() or [""])[0]
         raise ConfigError(key, str(path), f"a run file with its config intact: "
-                          f"{type(error).__name__}: {error}") from error
+                          f"{type(error).__name__}: {reason}") from error
     try:
         validate(stored)
     except (ConfigError, ValidationError) as error:  # a value edited in, read as it stands
@@ -123,6 +125,7 @@ def check_consistent(path, cfg, key="resume"):
     implies (a config edited in the file)."""
     n, _ = resources.disk_count(cfg)
     periodic = cfg.box.boundary == "periodic"
+    shown = str(path) if key == "resume" else str(Path(path).parent)  # a folder key: its folder
     try:
         with open_run_file(path) as f:
             disks = f["particles/disks"]
@@ -130,14 +133,16 @@ def check_consistent(path, cfg, key="resume"):
                      "box": [float(x) for x in disks["box/edges"][()]],
                      "boundary": [b.decode() for b in disks["box"].attrs["boundary"]]}
             root = f.get("checkpoint")
-            if root is None or "latest" not in root.attrs:
+            slots = [] if root is None or "latest" not in root.attrs else \
+                [slot for slot in (str(root.attrs["latest"]), "a", "b") if slot in root]
+            if not slots:
                 frames = disks["position/step"].shape[0]
-                raise ConfigError(key, str(path), f"a run file with a checkpoint to continue "
+                raise ConfigError(key, shown, f"a run file with a checkpoint to continue "
                                   f"from: it has none, and starting it again would overwrite "
                                   f"its {frames} snapshots; start a new run in another folder")
-            found["checkpointed disks"] = root[root.attrs["latest"]]["disks/table"].shape[0]
+            found["checkpointed disks"] = root[slots[0]]["disks/table"].shape[0]
     except (KeyError, OSError, RuntimeError) as error:  # RunFileError is an OSError
-        raise ConfigError(key, str(path), f"a readable run file: "
+        raise ConfigError(key, shown, f"a readable run file: "
                           f"{' '.join(str(error).split())}") from error
     wanted = {"disks": n, "box": [float(x) for x in cfg.box.size],
               "boundary": ["periodic" if periodic else "none"] * 2,
@@ -145,7 +150,7 @@ def check_consistent(path, cfg, key="resume"):
     wrong = [f"{name} {found[name]} in the file, {wanted[name]} by its config"
              for name in found if found[name] != wanted[name]]
     if wrong:
-        raise ConfigError(key, str(path), f"a run file whose data match its stored config "
+        raise ConfigError(key, shown, f"a run file whose data match its stored config "
                           f"(edited since the run?): {'; '.join(wrong)}")
 
 
@@ -201,13 +206,14 @@ def resume(path, overrides=()):
 
 
 def apply_overrides(stored, overrides):
-    """``stored`` with ``overrides`` applied; keys outside :data:`RESUMABLE` are refused."""
+    """``stored`` with ``overrides`` applied; keys outside :data:`RESUMABLE` are refused
+    unless they repeat the stored value."""
     keys = [item.partition("=")[0].lstrip("+~") for item in overrides]
-    fixed = [k for k, key in enumerate(keys) if key not in RESUMABLE]
-    if fixed:
-        raise ConfigError(keys[fixed[0]], overrides[fixed[0]].partition("=")[2],
-                          f"unchanged on resume (it would change what the run file "
-                          f"holds); a resume may change {', '.join(RESUMABLE)}")
+    for key, item in zip(keys, overrides, strict=True):
+        if key not in RESUMABLE and not _repeats(stored, item):
+            raise ConfigError(key, item.partition("=")[2],
+                              f"unchanged on resume (it would change what the run file "
+                              f"holds); a resume may change {', '.join(RESUMABLE)}")
     try:
         cfg = OmegaConf.merge(stored, OmegaConf.from_dotlist(list(overrides)))
     except ValidationError as error:
@@ -218,6 +224,17 @@ def apply_overrides(stored, overrides):
     if any(k == "output.every_collisions" for k in keys) and "output.every_time" not in keys:
         cfg.output.every_time = None
     return renamed_keys(cfg)
+
+
+def _repeats(stored, item):
+    """Whether the override ``item`` (``key=value``) gives its key the value ``stored``
+    holds."""
+    key = item.partition("=")[0].lstrip("+~")
+    try:
+        given = OmegaConf.select(OmegaConf.from_dotlist([item]), key)
+        return OmegaConf.select(stored, key, default=None) == given
+    except Exception:  # not a key of the config, or a value OmegaConf cannot read
+        return False
 
 
 def resume_locked(path, stored, reason, overrides, started):

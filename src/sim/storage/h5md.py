@@ -450,7 +450,7 @@ def read_checkpoint(file):
     intact."""
     root = file["checkpoint"]
     latest = str(root.attrs["latest"])
-    state = _slot_state(root[latest])
+    state = _slot_state(root[latest]) if latest in root else None  # missing: as damaged
     if state is not None:
         return (state, float(root[latest].attrs["time"]), int(root[latest].attrs["snapshots"]),
                 latest)
