@@ -428,6 +428,11 @@ NEVER = {
     "rdf-r_max-beyond-half-box": ("observe.radial_distribution.bins=50 "
                                   "observe.radial_distribution.r_max=100",
                                   "observe.radial_distribution.r_max"),
+    # a time reached only after more collisions than the engine counts (ran on for ever)
+    "time-beyond-2^62-collisions": ("disks.n=100 stop.collisions=null stop.time=1e50",
+                                    "stop.time"),
+    "time-beyond-2^62-collisions-sparse": ("disks.n=100 stop.collisions=null stop.time=1e50 "
+                                           "output.every_time=1e49", "stop.time"),
 }
 
 

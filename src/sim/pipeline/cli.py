@@ -23,6 +23,7 @@ in one line and an exit status, and :func:`hydra_main` runs each job.
 """
 
 import atexit
+import contextlib
 import logging
 import os
 import signal
@@ -179,14 +180,16 @@ def main():
             check_resources(args, configs)
         if sweeping and value_of(args, "hydra.sweep.dir") is not None:
             check_sweep_folder(args, configs)
+        guard = contextlib.nullcontext()
         if sweeping:
             args = joblib_workers(args, len(configs))
             sweep_dir = value_of(args, "hydra.sweep.dir")
             sweep_stop.clear(sweep_dir)  # left by a sweep killed there before
-            sweep_stop.guard_sweep(sweep_dir, stopped_by, stop_at_once)
+            guard = sweep_stop.guarded(sweep_dir, stopped_by, stop_at_once)
         sys.argv[1:] = flags_last(args)
         try:
-            hydra_main()
+            with guard:
+                hydra_main()
         except SystemExit as stop:
             if stop.code not in (0, None):
                 remove_made_folders()  # those still empty: a refusal leaves none behind

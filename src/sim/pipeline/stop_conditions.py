@@ -7,11 +7,15 @@ of disks that never meet, on the energy contacts dissipate where none can, or on
 energy that never changes would never hold;
 when every condition of a scene is of that kind, :func:`check_reachable` refuses the scene
 before any work. (A scene in which nothing moves at all ends by itself: the engine then has
-no event left, stop reason ``no_events``.)
+no event left, stop reason ``no_events``.) So does it refuse a ``stop.time`` that a gas
+whose energy never changes reaches only after more collisions than the engine counts
+(:data:`sim.engine.inputs.MAX_COUNT`), at its collision rate (:func:`collision_rate`).
 """
 
 import numpy as np
 
+from sim.analysis.theory import enskog_collision_frequency, henderson_z
+from sim.engine.inputs import MAX_COUNT
 from sim.pipeline.config import ConfigError
 
 #: Above this many disks the pairwise test of :func:`_disks_never_touch` is skipped (it is
@@ -97,10 +101,35 @@ def _dissipates(engine, never_touch):
             or (engine.wall_restitution is not None and not np.all(engine.periodic)))
 
 
+def collision_rate(engine):
+    """Disk–disk collisions per unit time of the disks of ``engine``, Enskog's N ω/2
+    (:func:`sim.analysis.theory.enskog_collision_frequency`) at their packing fraction (χ =
+    (Z − 1)/(2φ), Henderson's Z) and kinetic temperature T = E/N, every disk taken at the
+    mean diameter and mass: an estimate, to tens of percent for a gas near equilibrium."""
+    area = float(np.prod(engine.box))
+    phi = float(np.sum(np.pi * engine.radius**2)) / area
+    chi = (henderson_z(phi) - 1.0) / (2.0 * phi) if phi > 0.0 else 1.0
+    temperature = engine.kinetic_energy() / engine.n
+    omega = enskog_collision_frequency(engine.n / area, 2.0 * float(np.mean(engine.radius)),
+                                       chi, temperature, float(np.mean(engine.mass)))
+    return 0.5 * engine.n * omega
+
+
 def check_reachable(cfg, engine):
-    """Refuse (:class:`ConfigError` on ``stop``) a scene none of whose stop conditions can
-    ever hold for the initial state of ``engine``; see the module docstring."""
+    """Refuse (:class:`ConfigError` on ``stop``, or on ``stop.time``) a scene none of whose
+    stop conditions can ever hold for the initial state of ``engine``, or that reaches its
+    ``stop.time`` only after more collisions than the engine counts; see the module
+    docstring."""
     s = cfg.stop
+    if s.time is not None and s.wall_seconds is None and s.collisions is None \
+            and s.contacts is None and _conserves_kinetic_energy(engine) and engine.n > 1:
+        expected = collision_rate(engine) * (float(s.time) - engine.time)
+        if expected > MAX_COUNT:
+            longest = engine.time + MAX_COUNT / collision_rate(engine)
+            raise ConfigError("stop.time", s.time, f"a time these disks reach in at most "
+                              f"2^62 collisions, the engine's count: at their collision rate "
+                              f"that is t ≤ {longest:.3g} (this one takes some "
+                              f"{expected:.1g}); or add stop.collisions or stop.wall_seconds")
     if s.time is not None or s.wall_seconds is not None:
         return
     if np.all(engine.velocities() == 0.0) and engine.gravity is None \

@@ -13,7 +13,7 @@ clears the stop file (:func:`clear`), as does the next sweep into the folder. A 
 signal stops at once, as SIGKILL would.
 
 The sweep's process blocks both signals before its workers start and takes them in a thread
-of its own (:func:`guard_sweep`): workers inherit them blocked, and a job unblocks them while
+of its own (:func:`guarded`): workers inherit them blocked, and a job unblocks them while
 it runs (:func:`job`), so that a signal to a worker between two jobs neither kills it (which
 would break joblib's pool, killing the jobs still writing) nor is lost. The launcher starts
 no more workers than jobs (:func:`worker_count`).
@@ -61,13 +61,18 @@ def clear(sweep_dir):
 SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
-def guard_sweep(sweep_dir, taken, at_second_signal):
-    """In the sweep's process, before its workers start: the first SIGINT or SIGTERM is
-    ``taken(signal)`` and :func:`request`, a second ``at_second_signal(signal)``. Both
-    signals are blocked in this thread, so that the threads it starts and the workers they
-    spawn inherit them blocked (a worker between jobs then outlives a signal to its process
-    group); a thread of their own waits for them, and the handler takes those that reach
-    threads started before."""
+#: how often the sweep's signal thread looks whether the sweep is over (seconds)
+POLL_SECONDS = 0.1
+
+
+@contextmanager
+def guarded(sweep_dir, taken, at_second_signal):
+    """The sweep's process inside the block, which starts its workers: the first SIGINT or
+    SIGTERM is ``taken(signal)`` and :func:`request`, a second ``at_second_signal(signal)``.
+    Both signals are blocked in this thread, so that the threads it starts and the workers
+    they spawn inherit them blocked (a worker between jobs then outlives a signal to its
+    process group); a thread of their own waits for them, and the handler takes those that
+    reach threads started before. All is as it was after the block."""
     count = []
 
     def take(signum):
@@ -77,15 +82,27 @@ def guard_sweep(sweep_dir, taken, at_second_signal):
         taken(signal.Signals(signum))
         request(sweep_dir, signum)
 
-    for number in SIGNALS:
-        signal.signal(number, lambda signum, frame: take(signum))
+    previous = {number: signal.signal(number, lambda signum, frame: take(signum))
+                for number in SIGNALS}
     signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    over = threading.Event()
 
     def wait():
-        while True:
-            take(signal.sigwait(SIGNALS))
+        while not over.is_set():
+            arrived = signal.sigtimedwait(SIGNALS, POLL_SECONDS)
+            if arrived is not None:
+                take(arrived.si_signo)
 
-    threading.Thread(target=wait, name="sweep signals", daemon=True).start()
+    thread = threading.Thread(target=wait, name="sweep signals", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        over.set()
+        thread.join()
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
+        for number, handling in previous.items():
+            signal.signal(number, handling)
 
 
 @contextmanager
