@@ -121,8 +121,8 @@ def test_bad_values_are_refused_naming_the_disk_or_parameter():
             [[0.5, 0.25], [0.4, 0.25]], [[0.0, 0.0]] * 2, [0.01, 0.3],
             boundary=Boundary(size=(1.0, 0.5)))
     for size in ((1.0, np.nan), (0.0, 1.0), (1.0, np.inf)):
-        refused("box size must be two finite sides > 0", position, velocity, 0.02,
-                boundary=Boundary(size=size))
+        refused(r"Boundary\(size=\(.*\)\) is not allowed: two finite sides \(Lx, Ly\) > 0",
+                position, velocity, 0.02, boundary=Boundary(size=size))
 
     def wall(**spec):
         return {"walls": {"left": {"temperature": 1.0}, "top": spec}}
@@ -161,6 +161,54 @@ def test_the_engine_refuses_what_is_not_real_numbers_naming_the_argument():
             velocity, 0.01, species=[0, 1], restitution=np.full((3, 3), 0.9))
 
 
+#: Engine keywords that size its shells and lists, and boundaries, that no engine can take:
+#: (keywords, the words of the refusal); each raised before any work, without a warning
+BAD_ENGINE_OPTIONS = {
+    "shell-nan": ({"shell": np.nan}, "Engine(shell=nan) is not allowed: a finite shell"),
+    "shell-inf": ({"shell": np.inf}, "Engine(shell=inf)"),
+    "shell-1e300": ({"shell": 1e300}, "Engine(shell=1e+300) is not allowed: at most 101 = 1 + L/R"),
+    "shell-text": ({"shell": "2"}, "Engine(shell='2')"),
+    "shell-bool": ({"shell": True}, "Engine(shell=True)"),
+    "shell-1": ({"shell": 1.0}, "Engine(shell=1.0)"),
+    "shell-below-1": ({"shell": 0.5}, "Engine(shell=0.5)"),
+    "lead-nan": ({"shell_lead": np.nan}, "Engine(shell_lead=nan) is not allowed: a lead"),
+    "lead-text": ({"shell_lead": "x"}, "Engine(shell_lead='x')"),
+    "lead-1": ({"shell_lead": 1.0}, "Engine(shell_lead=1.0)"),
+    "lead-negative": ({"shell_lead": -0.1}, "Engine(shell_lead=-0.1)"),
+    "capacity-nan": ({"list_capacity": np.nan}, "Engine(list_capacity=nan) is not allowed: "
+                                                "a whole number from 1 to 2"),
+    "capacity-1e300": ({"list_capacity": 1e300}, "Engine(list_capacity=1e+300)"),
+    "capacity-negative": ({"list_capacity": -3}, "Engine(list_capacity=-3)"),
+    "capacity-0": ({"list_capacity": 0}, "Engine(list_capacity=0)"),
+    "capacity-fractional": ({"list_capacity": 2.5}, "Engine(list_capacity=2.5)"),
+    "capacity-text": ({"list_capacity": "8"}, "Engine(list_capacity='8')"),
+    "capacity-beyond-n": ({"list_capacity": 3}, "Engine(list_capacity=3)"),
+    "periodic-text": ({"boundary": Boundary(periodic="yes")}, "Boundary(periodic='yes') is "
+                                                                 "not allowed: True or False"),
+    "periodic-three": ({"boundary": Boundary(periodic=(True, True, False))},
+                       "Boundary(periodic=(True, True, False))"),
+    "periodic-numbers": ({"boundary": Boundary(periodic=(1, 1))}, "Boundary(periodic=(1, 1))"),
+    "size-number": ({"boundary": Boundary(size=2.0)}, "Boundary(size=2.0)"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_ENGINE_OPTIONS))
+def test_the_engine_refuses_bad_sizing_options_naming_them(case):
+    keywords, words = BAD_ENGINE_OPTIONS[case]
+    message = refused("^Engine|^Boundary", [[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]],
+                      0.01, **keywords)
+    assert words in message
+
+
+def test_the_engine_takes_sizing_options_as_documented():
+    """Whole floats and numpy numbers; one flag for both periodic axes."""
+    position, velocity = [[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]]
+    engine = Engine(position, velocity, 0.01, shell=np.float32(1.5), shell_lead=0,
+                    list_capacity=2.0, boundary=Boundary(periodic=True))
+    assert engine.periodic.tolist() == [True, True]
+    assert engine.disks.nb_cap.tolist() == [2, 2] and engine.geometry[5] == 0.0
+
+
 #: arguments of Engine.run that no run can take: (keywords, the words of the refusal)
 BAD_RUN_ARGUMENTS = {
     "collisions-negative": ({"collisions": -5}, "collisions=-5"),
@@ -196,6 +244,59 @@ def test_run_refuses_what_no_run_can_take_naming_the_argument(case):
     message = str(refusal.value)
     assert words in message and "\n" not in message
     assert engine.events == 0 and engine.time == 0.0
+
+
+#: stop conditions an elastic gas can never meet, alone: (keywords, the words of the refusal)
+UNREACHABLE_RUNS = {
+    "energy_fraction": ({"energy_fraction": 0.5},
+                        "run(energy_fraction=0.5) is not allowed: a fraction this engine can "
+                        "reach: no contact of it dissipates energy"),
+    "energy_fraction-0": ({"energy_fraction": 0}, "run(energy_fraction=0)"),
+    "time-1e300": ({"time": 1e300}, "run(time=1e+300) is not allowed: a time this engine can "
+                                    "reach: this engine's kinetic energy never changes"),
+    "time-1e20": ({"time": 1e20}, "run(time=1e+20)"),
+    "both": ({"time": 1e300, "energy_fraction": 0.5},
+             "run(time=1e+300, energy_fraction=0.5) is not allowed: neither can hold"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(UNREACHABLE_RUNS))
+def test_run_refuses_conditions_an_elastic_gas_never_meets(case):
+    """As the command line refuses such a ``stop``: no contact of elastic disks and walls
+    dissipates energy, and a gas whose kinetic energy never changes has an event at least
+    every 2 δ √(M/2E), so 2^62 events reach no further than ~1e17 here."""
+    keywords, words = UNREACHABLE_RUNS[case]
+    engine = gas(50, 0.2, seed=3)
+    with pytest.raises(ValueError) as refusal:
+        engine.run(**keywords)
+    message = str(refusal.value)
+    assert words in message and "another stop condition" in message and "\n" not in message
+    assert engine.events == 0 and engine.time == 0.0
+
+
+def test_run_takes_a_condition_another_one_or_dissipation_can_end():
+    """Not refused: another condition that ends the run, a fraction met already (1: at
+    once), an energy that inelastic disks dissipate, a time within reach."""
+    engine = gas(50, 0.2, seed=3)
+    assert engine.run(energy_fraction=0.5, collisions=100) == "collisions"
+    assert engine.run(time=1e300, events=engine.events + 100) == "events"
+    assert engine.run(energy_fraction=1.0) == "energy_fraction"
+    assert engine.run(time=engine.time + 0.1) == "time"
+    cooling = gas(50, 0.2, seed=3, restitution=0.5, tc=1e-6)
+    assert cooling.run(energy_fraction=0.5) == "energy_fraction"
+
+
+def test_an_elastic_gas_has_an_event_within_the_bound_of_its_latest_time():
+    """The premise of the refusal of a time beyond reach: a dilute gas (where events are
+    furthest apart), event by event, never waits longer than 2 δ √(M/2E) between two."""
+    engine = gas(50, 0.01, (True, False), seed=8)
+    latest, _ = engine._latest_time()
+    gap = latest / 2**62
+    before = engine.time
+    for _ in range(3000):
+        assert engine.run(events=engine.events + 1) == "events"
+        assert engine.time - before <= gap
+        before = engine.time
 
 
 def test_run_takes_whole_floats_and_numpy_numbers():

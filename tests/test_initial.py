@@ -99,6 +99,9 @@ def test_maxwellian_components_and_zero_drift():
         assert stats.kstest(components, stats.norm(scale=np.sqrt(0.7 / m)).cdf).pvalue > 1e-3
 
 
+#: ten small radii, for the placement refusals below
+R = np.full(10, 0.01)
+
 #: arguments of the placement helpers that no scene can take: (call, the words of the refusal)
 BAD_ARGUMENTS = {
     "lattice-no-disks": (lambda: hexagonal_lattice(0, 0.01), "hexagonal_lattice(n=0)"),
@@ -116,7 +119,93 @@ BAD_ARGUMENTS = {
     "packing-above-one": (lambda: radius_for_packing(10, 2.0),
                           "radius_for_packing(packing_fraction=2.0)"),
     "packing-complex": (lambda: radius_for_packing(10, 0.5j), "packing_fraction=0.5j"),
+    # boxes, regions and periodic flags that gave NaN positions or disks outside the box
+    "random-box-nan": (lambda: random_sequential(R, box=(np.nan, 1)),
+                       "random_sequential(box=(nan, 1))"),
+    "random-box-inf": (lambda: random_sequential(R, box=(np.inf, 1)), "box=(inf, 1)"),
+    "random-box-negative": (lambda: random_sequential(R, box=(-1, 1)), "box=(-1, 1)"),
+    "random-box-three-sides": (lambda: random_sequential(R, box=(1, 1, 1)), "box=(1, 1, 1)"),
+    "random-box-number": (lambda: random_sequential(R, box=1.0), "box=1.0"),
+    "random-region-outside": (lambda: random_sequential(R, region=((-5, 5), (0, 1))),
+                              "region=((-5, 5), (0, 1))"),
+    "random-region-inverted": (lambda: random_sequential(R, region=((0.8, 0.2), (0, 1))),
+                               "region=((0.8, 0.2), (0, 1))"),
+    "random-region-nan": (lambda: random_sequential(R, region=((0, np.nan), (0, 1))),
+                          "region=((0, nan), (0, 1))"),
+    "random-region-shape": (lambda: random_sequential(R, region=(0, 1)), "region=(0, 1)"),
+    "random-disk-wider-than-box": (lambda: random_sequential(np.full(1, 0.6)),
+                                   "a diameter 1.2 does not fit"),
+    "random-disk-wider-than-region": (
+        lambda: random_sequential(R, region=((0, 1), (0, 0.015))), "its side 0.015 along y"),
+    "random-periodic-text": (lambda: random_sequential(R, periodic="yes"), "periodic='yes'"),
+    "random-periodic-numbers": (lambda: random_sequential(R, periodic=(1, 0)),
+                                "periodic=(1, 0)"),
+    "random-periodic-three": (lambda: random_sequential(R, periodic=(True,) * 3),
+                              "periodic=(True, True, True)"),
+    "lattice-box-nan": (lambda: hexagonal_lattice(10, 0.01, box=(np.nan, 1)),
+                        "hexagonal_lattice(box=(nan, 1))"),
+    "lattice-box-inf": (lambda: hexagonal_lattice(10, 0.01, box=(np.inf, np.inf)),
+                        "box=(inf, inf)"),
+    "lattice-box-negative": (lambda: hexagonal_lattice(10, 0.01, box=(-1, -1)),
+                             "hexagonal_lattice(box=(-1, -1))"),
+    "lattice-region-inverted": (lambda: hexagonal_lattice(10, 0.01, region=((0, 1), (1, 0))),
+                                "region=((0, 1), (1, 0))"),
+    "lattice-periodic-text": (lambda: hexagonal_lattice(10, 0.01, periodic="no"),
+                              "periodic='no'"),
+    "lattice-radii-not-n": (lambda: hexagonal_lattice(10, [0.01, 0.02]), "one for each"),
+    "melt-box-nan": (lambda: melted_lattice(10, 0.01, box=(np.nan, 1)),
+                     "melted_lattice(box=(nan, 1))"),
+    # arrays of the wrong shape
+    "random-no-radii": (lambda: random_sequential([]), "random_sequential(radius=…)"),
+    "random-radii-2d": (lambda: random_sequential(np.full((2, 2), 0.01)), "1-D array"),
+    "maxwellian-masses-2d": (lambda: maxwellian([[1, 2], [3, 4]], 1),
+                             "maxwellian(mass=…) is not allowed: a mass, or a 1-D array"),
+    "maxwellian-no-masses": (lambda: maxwellian([], 1), "maxwellian(mass=…)"),
+    "drift-zero-mass": (lambda: remove_drift(np.ones((2, 2)), 0.0), "entry 0 is 0.0"),
+    "drift-masses-sum-zero": (lambda: remove_drift(np.ones((2, 2)), [1.0, -1.0]),
+                              "entry 1 is -1.0"),
+    "drift-nan-velocity": (lambda: remove_drift([[1.0, np.nan], [0.0, 0.0]], 1.0),
+                           "remove_drift(velocity=…) is not allowed: entry 1 is nan"),
+    "drift-velocity-shape": (lambda: remove_drift([1.0, 2.0], 1.0), "an array (n, 2)"),
+    "drift-masses-not-n": (lambda: remove_drift(np.ones((3, 2)), [1.0, 2.0]),
+                           "one for each of the n = 3"),
+    "drift-text": (lambda: remove_drift("fast", 1.0), "remove_drift(velocity='fast')"),
+    # seeds: whole numbers from 0 to 2^64 - 1, as numpy takes them
+    "random-seed-negative": (lambda: random_sequential(R, seed=-1),
+                             "random_sequential(seed=-1) is not allowed: a whole number from "
+                             "0 to 2^64 - 1"),
+    "random-seed-fractional": (lambda: random_sequential(R, seed=1.5), "seed=1.5"),
+    "random-seed-too-large": (lambda: random_sequential(R, seed=2**64), "seed=1844"),
+    "speed-seed-negative": (lambda: fixed_speed(3, 1.0, seed=-3), "fixed_speed(seed=-3)"),
+    "lattice-seed-text": (lambda: hexagonal_lattice(10, 0.01, seed="x"),
+                          "hexagonal_lattice(seed='x')"),
+    "maxwellian-seed-none": (lambda: maxwellian(1.0, 1.0, seed=None), "seed=None"),
+    "melt-seed-negative": (lambda: melted_lattice(10, 0.01, seed=-1),
+                           "melted_lattice(seed=-1)"),
+    # attempts and melts: refused, not a jam or a run that never ends
+    "random-attempts-nan": (lambda: random_sequential(R, max_attempts=np.nan),
+                            "max_attempts=nan"),
+    "random-attempts-huge": (lambda: random_sequential(R, max_attempts=1e300),
+                             "max_attempts=1e+300"),
+    "random-attempts-zero": (lambda: random_sequential(R, max_attempts=0),
+                             "random_sequential(max_attempts=0) is not allowed: a whole number "
+                             "from 1 to"),
+    "random-attempts-negative": (lambda: random_sequential(R, max_attempts=-1),
+                                 "max_attempts=-1"),
+    "melt-nan": (lambda: melted_lattice(10, 0.01, collisions_per_disk=np.nan),
+                 "melted_lattice(collisions_per_disk=nan)"),
+    "melt-inf": (lambda: melted_lattice(10, 0.01, collisions_per_disk=np.inf),
+                 "collisions_per_disk=inf"),
+    "melt-negative": (lambda: melted_lattice(10, 0.01, collisions_per_disk=-1),
+                      "melted_lattice(collisions_per_disk=-1)"),
+    "melt-for-ever": (lambda: melted_lattice(10, 0.01, collisions_per_disk=1e12),
+                      "collisions_per_disk=1000000000000.0) is not allowed: a number of "
+                      "collisions per disk from 0 to 10000"),
 }
+
+#: the refusals that are :class:`PlacementError` (disks that do not fit, which a scene's
+#: packing is refused for); every other is a plain ValueError naming an argument
+DO_NOT_FIT = {"random-disk-wider-than-box", "random-disk-wider-than-region"}
 
 
 @pytest.mark.parametrize("case", sorted(BAD_ARGUMENTS))
@@ -125,3 +214,23 @@ def test_placement_helpers_refuse_bad_arguments_naming_them(case):
     with pytest.raises(ValueError) as refusal:
         call()
     assert words in str(refusal.value) and "\n" not in str(refusal.value)
+    assert isinstance(refusal.value, PlacementError) == (case in DO_NOT_FIT)
+
+
+def test_placement_helpers_take_what_their_docstrings_allow():
+    """One flag for both axes, whole floats and numpy numbers, the largest seed, lists, and a
+    single disk to melt (nothing to collide with: it stays on its site)."""
+    np.testing.assert_array_equal(random_sequential(R, periodic=True, seed=np.int64(3)),
+                                  random_sequential(R, periodic=(True, True), seed=3))
+    np.testing.assert_array_equal(hexagonal_lattice(10, 0.01, periodic=np.bool_(False)),
+                                  hexagonal_lattice(10, 0.01))
+    assert random_sequential(R, seed=2**64 - 1, max_attempts=1e3).shape == (10, 2)
+    np.testing.assert_array_equal(fixed_speed(3, 1.0, seed=5.0), fixed_speed(3, 1.0, seed=5))
+    assert maxwellian(2.0, 1.0).shape == (1, 2)
+    np.testing.assert_array_equal(remove_drift([[1.0, 2.0], [3.0, 4.0]], [1.0, 1.0]),
+                                  [[-1.0, -1.0], [1.0, 1.0]])
+    position = random_sequential(R, box=(2.0, 0.5), region=((1.0, 2.0), (0.0, 0.5)), seed=1)
+    assert position[:, 0].min() >= 1.01 and position[:, 1].max() <= 0.49
+    np.testing.assert_array_equal(melted_lattice(1, 0.1, seed=4),
+                                  hexagonal_lattice(1, 0.1, seed=4))
+    assert melted_lattice(1, 0.1, collisions_per_disk=1e4).shape == (1, 2)

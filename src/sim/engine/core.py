@@ -25,8 +25,12 @@ from sim.engine.inputs import (
     check_disks,
     check_inside,
     check_scales,
+    periodic_pair,
     real_array,
+    real_number,
+    refused,
     species_input,
+    whole_count,
 )
 from sim.engine.kinematics import DISK_COLUMNS, RADIUS, VX, VY, X, Y
 from sim.engine.neighbours import build_all_neighbours, grow_lists, list_starts
@@ -62,14 +66,15 @@ class Engine(Running, Observables, Checkpoints):
     position, velocity : array (n, 2)
     radius, mass : array (n,) or scalar
     species : int array (n,), default all 0
-    boundary : :class:`Boundary`
-    shell : neighbour-shell diameter r_n/σ (default from the packing fraction around the
-        disks, :func:`packing_fraction_around_disks`)
+    boundary : :class:`Boundary` (size two finite sides > 0; periodic a bool or a pair)
+    shell : neighbour-shell diameter r_n/σ, finite, > 1 and at most 1 + L/R (L the longer
+        box side, R the median radius: a shell reaching across the box; default from the
+        packing fraction around the disks, :func:`packing_fraction_around_disks`)
     shell_lead : λ in [0, 1): a new shell is centred λ δ ahead of its disk along its
         velocity (:func:`sim.engine.neighbours.shell_centre`; default from the same packing
         fraction, :data:`LEAD_TABLE`); changes the cost, never the physics
-    list_capacity : initial slots per neighbour list of an ordinary disk (default from the
-        expected number of neighbours); full lists grow on demand
+    list_capacity : initial slots per neighbour list of an ordinary disk, whole from 1 to n
+        (default from the expected number of neighbours); full lists grow on demand
 
     The effects' keywords (keyword-only; each effect's ``KEYWORDS``, :mod:`sim.effects`):
 
@@ -89,7 +94,9 @@ class Engine(Running, Observables, Checkpoints):
         species = np.zeros(n, np.int32) if species is None else species_input(species, n)
         check_disks(position, velocity, radius, mass, species)
         box = box_size(boundary)
-        periodic = np.array(boundary.periodic, dtype=bool)
+        periodic = np.array(periodic_pair("Boundary", "periodic", boundary.periodic))
+        shell, shell_lead, list_capacity = _sizing_options(shell, shell_lead, list_capacity, n,
+                                                          box, radius)
         self.boundary = boundary
         self.n = n
         self.n_species = int(species.max()) + 1
@@ -161,12 +168,8 @@ class Engine(Running, Observables, Checkpoints):
         phi = float(np.pi * np.sum(radius**2) / np.prod(box))
         # shells and lists concern the small disks, where they are
         phi_small = packing_fraction_around_disks(position[~is_big], small_radius, box)
-        ratio = shell_ratio(phi_small) if shell is None else float(shell)
-        if ratio <= 1.0:
-            raise ValueError(f"shell (r_n/σ) must exceed 1, got {ratio}")
-        lead = shell_lead(phi_small) if lead is None else float(lead)
-        if not 0.0 <= lead < 1.0:
-            raise ValueError(f"shell_lead must lie in [0, 1), got {lead}")
+        ratio = shell_ratio(phi_small) if shell is None else shell
+        lead = shell_lead(phi_small) if lead is None else lead
         delta_small = 0.5 * (ratio - 1.0) * 2.0 * median
         max_small = float(small_radius.max())
         # the two largest radii: two disks whose shells overlap are less than R_i + R_j + 4 δ
@@ -195,7 +198,7 @@ class Engine(Running, Observables, Checkpoints):
         expected = 4.0 * phi_small * (1.0 + delta_small / median) ** 2
         if list_capacity is None:
             list_capacity = int(4 * math.ceil((expected + 3.0 * math.sqrt(expected) + 4.0) / 4))
-        cap = np.full(n, max(int(list_capacity), 1), dtype=np.int32)
+        cap = np.full(n, max(list_capacity, 1), dtype=np.int32)
         if big.size:
             density = max(phi_small, 0.6) / (np.pi * median**2)
             reach_big = radius[big] + delta[big] + reach
@@ -307,3 +310,23 @@ class Engine(Running, Observables, Checkpoints):
 
 
 Engine.__doc__ = Engine.__doc__.rstrip(" ") + keyword_doc()
+
+
+def _sizing_options(shell, shell_lead, list_capacity, n, box, radius):
+    """``shell`` (finite, > 1, at most 1 + L/R: L the longer box side, R the median radius),
+    ``shell_lead`` (in [0, 1)) and ``list_capacity`` (whole, from 1 to n) of :class:`Engine`
+    as float, float and int (None kept); a ValueError naming the first at fault."""
+    if shell is not None:
+        shell = real_number("Engine", "shell", shell, lambda s: 1.0 < s < math.inf,
+                            "a finite shell diameter r_n/σ > 1")
+        widest = 1.0 + float(np.max(box)) / float(np.median(radius))
+        if shell > widest:
+            raise refused("Engine", "shell", shell,
+                          f"at most {widest:.6g} = 1 + L/R (L the longer box side, R the "
+                          f"median radius), a shell reaching across the box")
+    if shell_lead is not None:
+        shell_lead = real_number("Engine", "shell_lead", shell_lead,
+                                 lambda lead: 0.0 <= lead < 1.0, "a lead λ in [0, 1)")
+    if list_capacity is not None:
+        list_capacity = whole_count("Engine", "list_capacity", list_capacity, low=1, high=n)
+    return shell, shell_lead, list_capacity

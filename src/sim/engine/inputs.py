@@ -50,11 +50,36 @@ def check_disks(position, velocity, radius, mass, species):
 
 
 def box_size(boundary):
-    """The box sides float64[2] of a :class:`Boundary`, refused unless finite and > 0."""
-    box = np.array(boundary.size, dtype=np.float64).reshape(-1)
-    if box.shape != (2,) or not np.all((box > 0.0) & (box < math.inf)):
-        raise ValueError(f"box size must be two finite sides > 0, got {boundary.size}")
+    """The box sides float64[2] of a :class:`Boundary`, each finite and > 0
+    (:func:`box_sides`)."""
+    return box_sides("Boundary", "size", boundary.size)
+
+
+def box_sides(call, name, size):
+    """The sides (Lx, Ly) of a box as float64[2], each finite and > 0; a ValueError naming
+    ``name`` of ``call`` otherwise."""
+    try:
+        box = real_array(call, name, size)
+    except ValueError:
+        box = None
+    if box is None or box.shape != (2,) or not np.all((box > 0.0) & (box < math.inf)):
+        raise refused(call, name, size, "two finite sides (Lx, Ly) > 0", show=True)
     return box
+
+
+def periodic_pair(call, name, periodic):
+    """``periodic``, one boolean for both axes or a pair (x, y) of booleans, as a tuple of two
+    bools; a ValueError naming ``name`` of ``call`` for anything else (0, 1 and text
+    included)."""
+    flags = (periodic, periodic) if isinstance(periodic, bool | np.bool_) else periodic
+    try:
+        pair = tuple(flags)
+    except TypeError:
+        pair = ()
+    if len(pair) != 2 or not all(isinstance(flag, bool | np.bool_) for flag in pair):
+        raise refused(call, name, periodic, "True or False (both axes), or a pair (x, y) of "
+                                            "them", show=True)
+    return bool(pair[0]), bool(pair[1])
 
 
 def check_inside(given, position, radius, box, periodic):
@@ -152,11 +177,30 @@ def check_scales(box, radius, mass, velocity, extent, gravity, motion, temperatu
 MAX_COUNT = 2**62
 
 
-def refused(call, name, value, allowed):
+def refused(call, name, value, allowed, show=False):
     """The ValueError of an argument ``name`` of the function ``call``: one line naming it,
-    its value (… for an array) and what is allowed."""
-    shown = "…" if isinstance(value, list | tuple | np.ndarray) else repr(value)
+    its value (… for an array, a list or a tuple, unless ``show``: for short ones such as a
+    box) and what is allowed."""
+    if not show and isinstance(value, list | tuple | np.ndarray):
+        shown = "…"
+    else:
+        shown = repr(value.tolist() if isinstance(value, np.ndarray) else _plain(value))
     return ValueError(f"{call}({name}={shown}) is not allowed: {allowed}")
+
+
+def _plain(value):
+    """``value`` with numpy numbers as Python numbers, in its tuples and lists too."""
+    if isinstance(value, list | tuple):
+        return type(value)(_plain(item) for item in value)
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def _number_text(number):
+    """2^k or 2^k - 1 for such numbers from 2^32 on, else the number."""
+    for power, text in ((number, ""), (number + 1, " - 1")):
+        if power >= 2**32 and power & (power - 1) == 0:
+            return f"2^{power.bit_length() - 1}{text}"
+    return str(number)
 
 
 def species_input(species, n):
@@ -171,7 +215,7 @@ def species_input(species, n):
 def whole_count(call, name, value, low=0, high=MAX_COUNT):
     """``value`` (an integer, or a float that is one, such as 1e6) as an int in [low, high];
     a ValueError naming ``name`` of ``call`` otherwise."""
-    allowed = f"a whole number from {low} to {high if high < MAX_COUNT else '2^62'}"
+    allowed = f"a whole number from {low} to {_number_text(high)}"
     if isinstance(value, bool | np.bool_):
         raise refused(call, name, value, allowed)
     try:
@@ -247,3 +291,29 @@ def check_stop(contacts, collisions, events, time, energy_fraction, wall_seconds
         raise refused("run", "until", until, "a function of the engine returning True to stop")
     return (*counts, time, energy_fraction, wall_seconds, until,
             whole_count("run", "chunk_events", chunk_events, low=1))
+
+
+def check_reachable(time, energy_fraction, energy_reachable, latest_time, time_reason):
+    """Refuse a run of :meth:`sim.engine.Engine.run` whose only stop conditions, ``time``
+    and ``energy_fraction`` (as given, which :func:`check_stop` accepted; None when not
+    given), can never hold, as the command line refuses such a ``stop``
+    (:func:`sim.pipeline.stop_conditions.check_reachable`): ``energy_fraction`` < 1 when
+    ``energy_reachable`` is False (no contact dissipates energy and the fraction is not met
+    already), ``time`` beyond ``latest_time`` (``time_reason`` says why)."""
+    why = {}
+    if energy_fraction is not None and float(energy_fraction) < 1.0 and not energy_reachable:
+        why["energy_fraction"] = ("a fraction this engine can reach: no contact of it "
+                                  "dissipates energy (elastic disks and walls, smooth or "
+                                  "elastic rough contacts)")
+    if time is not None and float(time) > latest_time:
+        why["time"] = f"a time this engine can reach: {time_reason}"
+    given = {name: value for name, value in (("time", time), ("energy_fraction", energy_fraction))
+             if value is not None}
+    if why and len(why) == len(given):
+        other = "; add another stop condition (collisions, contacts, events, wall_seconds, until)"
+        if len(why) == 1:
+            (name, allowed), = why.items()
+            raise refused("run", name, given[name], allowed + other)
+        shown = ", ".join(f"{name}={value!r}" for name, value in given.items())
+        raise ValueError(f"run({shown}) is not allowed: neither can hold: "
+                         + "; ".join(f"{name}: {text}" for name, text in why.items()) + other)

@@ -7,13 +7,14 @@ import time as wallclock
 
 import numpy as np
 
+from sim.effects.rotation import dissipates
 from sim.effects.walls import piston_jam
 from sim.engine import codes, loop
 from sim.engine.compilation import compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
 from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
-from sim.engine.inputs import check_stop
-from sim.engine.kinematics import VX, VY, X, Y
+from sim.engine.inputs import MAX_COUNT, check_reachable, check_stop
+from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 
 #: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
 #: take about this many seconds, from the rate of the chunk before, so that the budget is kept
@@ -98,13 +99,20 @@ class Running:
         Counts are whole numbers from 0 to 2^62, ``time`` finite and ≥ 0, ``energy_fraction``
         in [0, 1], ``wall_seconds`` finite and ≥ 0, ``chunk_events`` whole and ≥ 1: anything
         else is a ValueError naming the argument, before any event
-        (:func:`sim.engine.inputs.check_stop`). The piston-jam guard (:meth:`_check_piston`)
+        (:func:`sim.engine.inputs.check_stop`). A run given no condition but ``time`` and
+        ``energy_fraction``, none of which can ever hold, is refused too, as the command line
+        refuses such a ``stop`` (:func:`sim.engine.inputs.check_reachable`):
+        ``energy_fraction`` < 1 where no contact dissipates energy, a ``time`` beyond what the
+        2^62 events a run may count reach where the kinetic energy never changes
+        (:meth:`_latest_time`). The piston-jam guard (:meth:`_check_piston`)
         runs after every chunk, whatever ended it. Chunk sizes change no result: the same
         inputs give the same bits.
         """
+        given = time, energy_fraction  # as written, for a refusal
         (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
          chunk_events) = check_stop(contacts, collisions, events, time, energy_fraction,
                                     wall_seconds, until, chunk_events)
+        self._refuse_unreachable(contacts, collisions, events, *given, wall_seconds, until)
         big = np.iinfo(np.int64).max
         max_contacts = big if contacts is None else contacts
         max_events = big if events is None else events
@@ -146,6 +154,42 @@ class Running:
                 ask_at += chunk_events
                 if until is not None and until(self):
                     return "predicate"
+
+    def _refuse_unreachable(self, contacts, collisions, events, time, energy_fraction,
+                            wall_seconds, until):
+        """:func:`check_reachable` for the arguments of :meth:`run`, which
+        :func:`check_stop` accepted."""
+        others = (contacts, collisions, events, wall_seconds, until)
+        if all(x is None for x in others) and (time is not None or energy_fraction is not None):
+            periodic_only = bool(np.all(self.periodic))
+            dissipating = (self.restitution is not None or dissipates(self.roughness, self.friction)
+                           or (self.wall_restitution is not None and not periodic_only))
+            met = (energy_fraction is not None and self.dissipated_energy
+                   >= self.initial_energy * (1.0 - float(energy_fraction)))
+            check_reachable(time, energy_fraction, dissipating or met,
+                            *self._latest_time())
+
+    def _latest_time(self):
+        """The latest time the engine can reach in the events left to it (2^62 in all), inf
+        where no bound is known. Bounded when the kinetic energy E never changes (elastic
+        smooth disks, elastic or no walls, no gravity, still walls that are not thermal):
+        the fastest disk, at least as fast as √(2E/M) (M the total mass), flies straight
+        across at most its shell's diameter 2 δ before its next event, so some event comes
+        at least every 2 δ √(M / 2E). Returns (that time, the reason in words)."""
+        walls = self.wall_restitution is not None and not np.all(self.periodic)
+        if (self.restitution is not None or walls or self.roughness is not None
+                or self.gravity is not None or self.wall_motion is not None
+                or self.wall_temperature is not None):
+            return math.inf, ""
+        speed_squared = 2.0 * self.kinetic_energy() / float(self.mass.sum())
+        if not speed_squared > TINY_SPEED_SQUARED:
+            return math.inf, ""
+        gap = 2.0 * float(np.max(self.disks.delta)) / math.sqrt(speed_squared)
+        latest = self.time + (MAX_COUNT - self.events) * gap
+        reason = (f"this engine's kinetic energy never changes, so some event (a contact or a "
+                  f"shell exit) comes at least every {gap:.3g} time units, and the 2^62 "
+                  f"events a run may count reach t = {latest:.3g} at most")
+        return latest, reason
 
     def _check_piston(self):
         """Raise :class:`ClosedBoxError` when a piston has jammed the disks

@@ -40,7 +40,8 @@ RSA_JAMMING = 0.547
 #: 64-bit word holds the command line's seed and the next ones its scenes draw with.
 MAX_HELPER_SEED = 2**64 - 1
 
-#: Most attempts :func:`random_sequential` may make to place one disk.
+#: Most attempts :func:`random_sequential` may make to place one disk (a bound on the time a
+#: packing it cannot reach takes to be refused).
 MAX_ATTEMPTS = 10**9
 
 
