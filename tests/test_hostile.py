@@ -768,6 +768,22 @@ def test_inspect_of_a_live_run_file_is_one_line(live_run):
     check(Result(done.returncode, done.stdout, done.stderr), 2, ["run.h5"])
 
 
+def test_inspect_names_the_run_writing_a_file_whatever_hdf5_locks(small_run, tmp_path,
+                                                                   capsys):
+    """sim's own lock, which ``HDF5_USE_FILE_LOCKING=FALSE`` leaves in place, says a run is
+    writing the file: one line naming the process, exit 2."""
+    from sim.pipeline.run_folder import RunLock
+    from sim.storage import inspect
+
+    good = copy_run(small_run, tmp_path)
+    with RunLock(good):
+        capsys.readouterr()
+        code = inspect.main([str(good)])
+    out, err = capsys.readouterr()
+    check(Result(code, out, err), 2, [str(os.getpid()), "being written"])
+    assert inspect.main([str(good)]) == 0  # the run over: read as ever
+
+
 def test_resume_of_a_live_run_file_is_refused(live_run):
     process, folder = live_run
     before = set(tree(folder))

@@ -99,6 +99,27 @@ def held(path):
         os.close(fd)
 
 
+def writer_of(path):
+    """Who holds the lock of the run file ``path`` (``process N``, or ``another process``),
+    or None when no run does: a shared ``flock`` of its lock file, asked without waiting and
+    let go at once. Readers ask it where HDF5's own locks may be off."""
+    try:
+        fd = os.open(lock_path(path), os.O_RDONLY)
+    except OSError:  # no lock file: no run
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        return None
+    except BlockingIOError:
+        pid = os.read(fd, 32).decode(errors="replace").strip()
+        return f"process {pid}" if pid else "another process"
+    except OSError:  # a file system without locks: none to ask
+        return None
+    finally:
+        os.close(fd)
+
+
 def part_path(path):
     """Where a new run file is written until :func:`publish` puts it in place."""
     return Path(path).with_name(f".{Path(path).name}.part")

@@ -321,6 +321,13 @@ def main(argv=None):
     parser.add_argument("path", help="run file (run.h5)")
     parser.add_argument("--json", action="store_true", help="one JSON object")
     args = parser.parse_args(argv)
+    from sim.pipeline.run_folder import writer_of  # the run's own lock: HDF5's may be off
+
+    writer = writer_of(args.path)
+    if writer is not None:
+        print(f"sim-inspect: {args.path} is being written by {writer}, a run still going; "
+              f"read it when that run has ended", file=sys.stderr)
+        return 2
     try:
         info = summary(args.path)
     except RunFileError as error:
