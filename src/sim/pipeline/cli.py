@@ -89,8 +89,8 @@ def hydra_main(cfg):
     sweeping = HydraConfig.get().mode == RunMode.MULTIRUN
     output_dir = HydraConfig.get().runtime.output_dir
     warnings.showwarning = warn_in_one_line  # also in a sweep's workers
+    Interruption.sweep_dir = HydraConfig.get().sweep.dir if sweeping else None
     if sweeping:
-        Interruption.sweep_dir = HydraConfig.get().sweep.dir
         with sweep_stop.job(Interruption.sweep_dir, stop_at_once):
             asked = sweep_stop.requested(Interruption.sweep_dir)
             if asked is not None:  # the sweep was stopped before this job began
