@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import assert_no_overlap, gas
+from sim.effects import loop_values
 from sim.engine import (
     Boundary,
     ClosedBoxError,
@@ -132,20 +133,24 @@ def test_bad_values_are_refused_naming_the_disk_or_parameter():
                 **wall(temperature=t_wall))
     for spec in ({"speed": np.nan}, {"speed": np.inf}, {"amplitude": -0.1, "frequency": 1.0},
                  {"amplitude": 0.1, "frequency": np.inf}, {"amplitude": np.nan}):
-        refused("top wall: speed .* must be finite", position, velocity, 0.02, **wall(**spec))
+        refused(r"^Engine\(walls=.* top wall: (speed|amplitude|frequency) .* must be finite",
+                position, velocity, 0.02, **wall(**spec))
     refused(r"top wall: unknown keys \['temprature'\]", position, velocity, 0.02,
             **wall(temprature=1.0))
     for g in ([0.0, np.nan], [np.inf, 0.0]):
-        refused("gravity must be two finite numbers", position, velocity, 0.02, gravity=g)
+        refused(r"^Engine\(gravity=\[.*\]\) is not allowed: two finite numbers", position,
+                velocity, 0.02, gravity=g)
     for tc in (np.nan, np.inf, -1e-8):
-        refused("tc .* must be finite and ≥ 0", position, velocity, 0.02, restitution=0.9,
-                tc=tc)
+        refused(r"^Engine\(tc=.*\) is not allowed: the TC-model time t_c, finite and ≥ 0",
+                position, velocity, 0.02, restitution=0.9, tc=tc)
     for xi in (np.nan, 1.5, -0.1):
-        refused("restitution must lie in", position, velocity, 0.02, restitution=xi)
-        refused("wall_restitution must lie in", position, velocity, 0.02, wall_restitution=xi)
+        refused(r"^Engine\(restitution=.*\) is not allowed: .* in \[0, 1\]", position,
+                velocity, 0.02, restitution=xi)
+        refused(r"^Engine\(wall_restitution=.*\) is not allowed: a number in \[0, 1\]",
+                position, velocity, 0.02, wall_restitution=xi)
     for seed in (-1, 2**63, 1.5, "7"):
-        refused(r"seed must be an integer in \[0, 2\*\*63 - 1\]", position, velocity, 0.02,
-                seed=seed)
+        refused(r"^Engine\(seed=.*\) is not allowed: a whole number from 0 to 2\^63 - 1",
+                position, velocity, 0.02, seed=seed)
     assert Engine(position, velocity, 0.02, seed=2**63 - 1).seed == 2**63 - 1
 
 
@@ -157,8 +162,8 @@ def test_the_engine_refuses_what_is_not_real_numbers_naming_the_argument():
     refused(r"Engine\(velocity=…\)", position, [[1.0], [-1.0, 0.0]], 0.01)
     refused(r"Engine\(species=…\) is not allowed: whole numbers", position, velocity, 0.01,
             species=[0.5, 1])
-    refused(r"restitution must be one number or a 2 × 2 matrix .* shape \(3, 3\)", position,
-            velocity, 0.01, species=[0, 1], restitution=np.full((3, 3), 0.9))
+    refused(r"^Engine\(restitution=…\) is not allowed: one number or a symmetric 2 × 2 matrix",
+            position, velocity, 0.01, species=[0, 1], restitution=np.full((3, 3), 0.9))
 
 
 #: Engine keywords that size its shells and lists, and boundaries, that no engine can take:
@@ -207,6 +212,211 @@ def test_the_engine_takes_sizing_options_as_documented():
                     list_capacity=2.0, boundary=Boundary(periodic=True))
     assert engine.periodic.tolist() == [True, True]
     assert engine.disks.nb_cap.tolist() == [2, 2] and engine.geometry[5] == 0.0
+
+
+PERIODIC = Boundary(periodic=True)
+TWO_SPECIES = {"species": [0, 1]}
+
+#: the effects' Engine keywords (each effect's KEYWORDS) that no engine can take: (keywords,
+#: the words of the refusal, which names the keyword); ``species`` and ``boundary`` set the
+#: scene. Each is refused before any work, in the format of sim.engine.inputs.refused.
+BAD_EFFECT_KEYWORDS = {
+    # restitution
+    "restitution-nan": ({"restitution": np.nan},
+                        "Engine(restitution=nan) is not allowed: one number or a symmetric "
+                        "1 × 1 matrix"),
+    "restitution-text": ({"restitution": "0.9"}, "Engine(restitution='0.9')"),
+    "restitution-bool": ({"restitution": True}, "Engine(restitution=True)"),
+    "restitution-shape": ({"restitution": [0.9, 0.9], **TWO_SPECIES},
+                          "Engine(restitution=[0.9, 0.9]) is not allowed: one number or a "
+                          "symmetric 2 × 2 matrix"),
+    "restitution-asymmetric": ({"restitution": [[0.9, 0.8], [0.7, 0.9]], **TWO_SPECIES},
+                               "Engine(restitution=[[0.9, 0.8], [0.7, 0.9]]) is not allowed: "
+                               "a symmetric 2 × 2 matrix"),
+    "wall_restitution-text": ({"wall_restitution": "0.5"},
+                              "Engine(wall_restitution='0.5') is not allowed: a number in "
+                              "[0, 1]"),
+    "wall_restitution-bool": ({"wall_restitution": False}, "Engine(wall_restitution=False)"),
+    "wall_restitution-list": ({"wall_restitution": [0.5] * 4}, "Engine(wall_restitution=…)"),
+    "collapse_interval-nan": ({"collapse_interval": np.nan},
+                              "Engine(collapse_interval=nan) is not allowed: a finite time > 0"),
+    "collapse_interval-inf": ({"collapse_interval": np.inf}, "Engine(collapse_interval=inf)"),
+    "collapse_interval-0": ({"collapse_interval": 0.0}, "Engine(collapse_interval=0.0)"),
+    "collapse_interval-negative": ({"collapse_interval": -1e-6},
+                                   "Engine(collapse_interval=-1e-06)"),
+    "collapse_interval-text": ({"collapse_interval": "1e-6"},
+                               "Engine(collapse_interval='1e-6')"),
+    "collapse_streak-nan": ({"collapse_streak": np.nan},
+                            "Engine(collapse_streak=nan) is not allowed: a whole number from 0 "
+                            "to 2^62"),
+    "collapse_streak-1e300": ({"collapse_streak": 1e300}, "Engine(collapse_streak=1e+300)"),
+    "collapse_streak-negative": ({"collapse_streak": -1}, "Engine(collapse_streak=-1)"),
+    "collapse_streak-fractional": ({"collapse_streak": 2.5}, "Engine(collapse_streak=2.5)"),
+    "collapse_streak-bool": ({"collapse_streak": True}, "Engine(collapse_streak=True)"),
+    "collapse_streak-text": ({"collapse_streak": "10"}, "Engine(collapse_streak='10')"),
+    # tc
+    "tc-text": ({"tc": "1e-4", "restitution": 0.9}, "Engine(tc='1e-4') is not allowed: the "
+                                                    "TC-model time t_c, finite and ≥ 0"),
+    "tc-bool": ({"tc": True, "restitution": 0.9}, "Engine(tc=True)"),
+    "tc-complex": ({"tc": 1j}, "Engine(tc=1j)"),
+    # gravity
+    "gravity-text": ({"gravity": ["0", "-1"]}, "Engine(gravity=['0', '-1']) is not allowed: "
+                                               "two finite numbers [gx, gy]"),
+    "gravity-column": ({"gravity": [[0.0], [-1.0]]}, "Engine(gravity=[[0.0], [-1.0]])"),
+    "gravity-three": ({"gravity": [0.0, -1.0, 0.0]}, "Engine(gravity=[0.0, -1.0, 0.0])"),
+    "gravity-number": ({"gravity": -1.0}, "Engine(gravity=-1.0)"),
+    "gravity-bools": ({"gravity": [False, True]}, "Engine(gravity=[False, True])"),
+    "gravity-periodic": ({"gravity": [0.0, -1.0], "boundary": PERIODIC},
+                         "Engine(gravity=[0.0, -1.0]) is not allowed: no component along a "
+                         "periodic axis"),
+    # walls
+    "walls-text": ({"walls": "top"}, "Engine(walls='top') is not allowed: None or a mapping "
+                                     "of wall names"),
+    "walls-list": ({"walls": [("top", {"speed": 0.1})]}, "Engine(walls=…) is not allowed"),
+    "walls-unknown-wall": ({"walls": {"roof": {"speed": 0.1}}},
+                           "Engine(walls={'roof': {'speed': 0.1}}) is not allowed: unknown "
+                           "wall 'roof'"),
+    "walls-spec-number": ({"walls": {"top": 1.0}}, "Engine(walls={'top': 1.0}) is not allowed: "
+                                                   "top wall: None or a mapping"),
+    "walls-unknown-key": ({"walls": {"top": {"temprature": 1.0}}},
+                          "is not allowed: top wall: unknown keys ['temprature']"),
+    "walls-temperature-nan": ({"walls": {"top": {"temperature": np.nan}}},
+                              "Engine(walls={'top': {'temperature': nan}}) is not allowed: top "
+                              "wall: temperature nan must be finite and > 0"),
+    "walls-temperature-text": ({"walls": {"top": {"temperature": "1"}}},
+                               "top wall: temperature '1' must be finite and > 0"),
+    "walls-temperature-bool": ({"walls": {"top": {"temperature": True}}},
+                               "top wall: temperature True must be finite and > 0"),
+    "walls-speed-text": ({"walls": {"top": {"speed": "0.1"}}},
+                         "top wall: speed '0.1' must be finite"),
+    "walls-speed-none": ({"walls": {"top": {"speed": None}}}, "top wall: speed None must be"),
+    "walls-frequency-list": ({"walls": {"top": {"amplitude": 0.01, "frequency": [1.0, 2.0]}}},
+                             "top wall: frequency [1.0, 2.0] must be finite and ≥ 0"),
+    "walls-amplitude-without-frequency": ({"walls": {"top": {"amplitude": 0.01}}},
+                                          "top wall: an angular frequency > 0 for a wall "
+                                          "with an amplitude"),
+    "walls-periodic": ({"walls": {"top": {"speed": 0.1}}, "boundary": PERIODIC},
+                       "Engine(walls={'top': {'speed': 0.1}}) is not allowed: top wall is "
+                       "given on a periodic axis"),
+    # thermal walls: the seed
+    "seed-nan": ({"seed": np.nan}, "Engine(seed=nan) is not allowed: a whole number from 0 "
+                                   "to 2^63 - 1"),
+    "seed-1e300": ({"seed": 1e300}, "Engine(seed=1e+300)"),
+    "seed-bool": ({"seed": True}, "Engine(seed=True)"),
+    "seed-text": ({"seed": "7"}, "Engine(seed='7')"),
+    "seed-negative": ({"seed": -1}, "Engine(seed=-1)"),
+    "seed-nan-spins": ({"seed": np.nan, "rotational_temperature": 1.0}, "Engine(seed=nan)"),
+    # recorders
+    "unwrap-text": ({"unwrap": "yes"}, "Engine(unwrap='yes') is not allowed: True or False"),
+    "unwrap-1": ({"unwrap": 1}, "Engine(unwrap=1)"),
+    "unwrap-none": ({"unwrap": None}, "Engine(unwrap=None)"),
+    "pressure_tensor-text": ({"pressure_tensor": "no"},
+                             "Engine(pressure_tensor='no') is not allowed: True or False"),
+    "pressure_tensor-0": ({"pressure_tensor": 0}, "Engine(pressure_tensor=0)"),
+    "pressure_tensor-text-rough": ({"pressure_tensor": "no", "tangential_restitution": 0.5},
+                                   "Engine(pressure_tensor='no') is not allowed: True or False"),
+    "event_log-nan": ({"event_log": np.nan}, "Engine(event_log=nan) is not allowed: a whole "
+                                             "number from 1 to 16777216"),
+    "event_log-1e300": ({"event_log": 1e300}, "Engine(event_log=1e+300)"),
+    "event_log-bool": ({"event_log": True}, "Engine(event_log=True)"),
+    "event_log-0": ({"event_log": 0}, "Engine(event_log=0)"),
+    "event_log-negative": ({"event_log": -5}, "Engine(event_log=-5)"),
+    "event_log-fractional": ({"event_log": 2.5}, "Engine(event_log=2.5)"),
+    "event_log-text": ({"event_log": "1000"}, "Engine(event_log='1000')"),
+    # rotation
+    "tangential_restitution-nan": ({"tangential_restitution": np.nan},
+                                   "Engine(tangential_restitution=nan) is not allowed: one "
+                                   "number or a symmetric 1 × 1 matrix"),
+    "tangential_restitution-1.5": ({"tangential_restitution": 1.5},
+                                   "Engine(tangential_restitution=1.5)"),
+    "tangential_restitution-text": ({"tangential_restitution": "0.5"},
+                                    "Engine(tangential_restitution='0.5')"),
+    "tangential_restitution-shape": ({"tangential_restitution": [0.5, 0.5, 0.5]},
+                                     "Engine(tangential_restitution=[0.5, 0.5, 0.5])"),
+    "tangential_restitution-asymmetric": ({"tangential_restitution": [[0.5, 0.1], [0.2, 0.5]],
+                                           **TWO_SPECIES},
+                                          "Engine(tangential_restitution=[[0.5, 0.1], [0.2, "
+                                          "0.5]]) is not allowed: a symmetric 2 × 2 matrix"),
+    "wall_tangential_restitution-three": ({"wall_tangential_restitution": [0.5] * 3},
+                                          "Engine(wall_tangential_restitution=[0.5, 0.5, 0.5]) "
+                                          "is not allowed: one number for every wall or four"),
+    "wall_tangential_restitution-nan": ({"wall_tangential_restitution": np.nan},
+                                        "Engine(wall_tangential_restitution=nan)"),
+    "wall_tangential_restitution-bool": ({"wall_tangential_restitution": True},
+                                         "Engine(wall_tangential_restitution=True)"),
+    "friction-nan": ({"friction": np.nan, "tangential_restitution": 0.5},
+                     "Engine(friction=nan) is not allowed: one number or a symmetric 1 × 1 "
+                     "matrix (a row and a column per species) of finite values ≥ 0"),
+    "friction-inf": ({"friction": np.inf, "tangential_restitution": 0.5},
+                     "Engine(friction=inf)"),
+    "friction-negative": ({"friction": -0.1, "tangential_restitution": 0.5},
+                          "Engine(friction=-0.1)"),
+    "friction-text": ({"friction": "0.1", "tangential_restitution": 0.5},
+                      "Engine(friction='0.1')"),
+    "friction-smooth": ({"friction": 0.3}, "Engine(friction=0.3) is not allowed: None with "
+                                           "smooth contacts"),
+    "wall_friction-nan": ({"wall_friction": np.nan, "wall_tangential_restitution": 0.5},
+                          "Engine(wall_friction=nan) is not allowed: one number for every wall"),
+    "wall_friction-shape": ({"wall_friction": [[0.1, 0.1], [0.1, 0.1]],
+                             "wall_tangential_restitution": 0.5},
+                            "Engine(wall_friction=[[0.1, 0.1], [0.1, 0.1]])"),
+    "wall_friction-periodic": ({"wall_friction": 0.1, "tangential_restitution": 0.5,
+                                "wall_tangential_restitution": 0.5, "boundary": PERIODIC},
+                               "Engine(wall_friction=0.1) is not allowed: None: a periodic box "
+                               "has no walls"),
+    "inertia_factor-0": ({"inertia_factor": 0.0}, "Engine(inertia_factor=0.0) is not allowed: "
+                                                  "q = I/(m a²) in (0, 1]"),
+    "inertia_factor-nan": ({"inertia_factor": np.nan}, "Engine(inertia_factor=nan)"),
+    "inertia_factor-text": ({"inertia_factor": "0.5"}, "Engine(inertia_factor='0.5')"),
+    "inertia_factor-bool": ({"inertia_factor": True}, "Engine(inertia_factor=True)"),
+    "spin-nan": ({"spin": np.nan}, "Engine(spin=nan) is not allowed: one finite number or "
+                                   "n = 2 of them"),
+    "spin-shape": ({"spin": [1.0, 2.0, 3.0]}, "Engine(spin=[1.0, 2.0, 3.0])"),
+    "spin-text": ({"spin": "1"}, "Engine(spin='1')"),
+    "spin-and-temperature": ({"spin": [1.0, 2.0], "rotational_temperature": 1.0},
+                             "Engine(rotational_temperature=1.0) is not allowed: 0 when "
+                             "``spin`` is given"),
+    "rotational_temperature-nan": ({"rotational_temperature": np.nan},
+                                   "Engine(rotational_temperature=nan) is not allowed: a "
+                                   "finite temperature ≥ 0"),
+    "rotational_temperature-inf": ({"rotational_temperature": np.inf},
+                                   "Engine(rotational_temperature=inf)"),
+    "rotational_temperature-text": ({"rotational_temperature": "1"},
+                                    "Engine(rotational_temperature='1')"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_EFFECT_KEYWORDS))
+def test_the_engine_refuses_bad_effect_keywords_naming_them(case):
+    """Every effect keyword is checked as the command line checks its config key: a
+    ValueError of one line naming the keyword, its value and what is allowed."""
+    keywords, words = BAD_EFFECT_KEYWORDS[case]
+    keywords = dict(keywords)
+    scene = {"species": keywords.pop("species", None),
+             "boundary": keywords.pop("boundary", Boundary())}
+    message = refused("^Engine", [[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]], 0.01,
+                      **scene, **keywords)
+    assert words in message
+
+
+def test_the_effect_keywords_take_numpy_numbers_and_whole_floats():
+    """What the table above refuses is all: numpy booleans and numbers, whole floats, tuples."""
+    scene = {"n": 2, "n_species": 2, "box": np.ones(2), "periodic": np.zeros(2, dtype=bool),
+             "radius": np.full(2, 0.01), "mass": np.ones(2), "initial_energy": 1.0}
+    values, _ = loop_values({
+        "unwrap": np.True_, "pressure_tensor": np.False_, "event_log": np.int64(100),
+        "seed": 7.0, "collapse_streak": np.int32(5), "collapse_interval": np.float32(1e-3),
+        "restitution": ((0.9, 0.8), (0.8, 0.9)), "wall_restitution": np.float64(0.5),
+        "tc": 0, "gravity": (0, -1), "inertia_factor": 1, "spin": np.int64(2),
+        "walls": {"top": {"temperature": np.float32(2.0), "speed": 0}, "left": None,
+                  "right": {"amplitude": 0.01, "frequency": np.int64(3)}}}, scene)
+    assert values["images"].shape == (2, 2) and values["virial_tensor"] is None
+    assert values["event_log"][0].shape == (100, 6) and values["seed"] == 7
+    assert values["collapse"] == (np.float32(1e-3), 5) and values["tc"] is None
+    assert values["restitution"].tolist() == [[0.9, 0.8], [0.8, 0.9]]
+    assert values["gravity"].tolist() == [0.0, -1.0] and values["spin"].tolist() == [2.0, 2.0]
+    assert values["wall_temperature"][3] == 2.0 and values["wall_motion"][1].tolist() == [
+        0.0, 0.01, 3.0]
 
 
 #: arguments of Engine.run that no run can take: (keywords, the words of the refusal)

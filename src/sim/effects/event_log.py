@@ -11,6 +11,7 @@ engine renames the disks.
 import numpy as np
 
 from sim.effects.rules import effect_rule
+from sim.engine.inputs import whole_count
 
 #: columns of the event log
 LOG_TIME, LOG_DISK, LOG_PARTNER, LOG_IMPULSE, LOG_DISSIPATED, LOG_CONTACT = range(6)
@@ -19,10 +20,14 @@ LOG_COLUMNS = 6
 #: rows of the compiled event log between drains when a run logs events (6 float64 each)
 EVENT_LOG_ROWS = 1 << 16
 
-KEYWORDS = {"event_log": (None, "rows buffered in the loop for the log of every contact; None "
-                                "= no log. Full buffers go to :attr:`event_sink` (a callable "
-                                "taking float64[k, 6], e.g. the run file's writer) or else are "
-                                "kept for :meth:`take_event_log`")}
+#: the most rows an engine may buffer (48 bytes each: 768 MiB); more only delays the drains
+EVENT_LOG_MAX_ROWS = 1 << 24
+
+KEYWORDS = {"event_log": (None, "rows buffered in the loop for the log of every contact, a "
+                                "whole number from 1 to 2^24; None = no log. Full buffers go "
+                                "to :attr:`event_sink` (a callable taking float64[k, 6], e.g. "
+                                "the run file's writer) or else are kept for "
+                                ":meth:`take_event_log`")}
 
 
 def check_config(cfg):
@@ -35,10 +40,13 @@ def engine_arguments(cfg):
 
 
 def loop_values(keywords, context):
-    """The empty log (rows, fill), or None."""
+    """The empty log (rows, fill), or None; ``event_log`` None or a whole number of rows from
+    1 to :data:`EVENT_LOG_MAX_ROWS` (booleans refused)."""
     rows = keywords["event_log"]
-    return {"event_log": None if rows is None
-            else (np.zeros((max(int(rows), 1), LOG_COLUMNS)), np.zeros(1, dtype=np.int64))}
+    if rows is None:
+        return {"event_log": None}
+    rows = whole_count("Engine", "event_log", rows, low=1, high=EVENT_LOG_MAX_ROWS)
+    return {"event_log": (np.zeros((rows, LOG_COLUMNS)), np.zeros(1, dtype=np.int64))}
 
 
 def _not_logged(event_log, t_abs, i, partner, impulse, lost, contact):

@@ -27,11 +27,13 @@ from numba import types
 from numba.extending import overload
 
 from sim.effects.rules import effect_rule
+from sim.engine.inputs import refused, shaped_reals
 from sim.engine.kinematics import VX, shell_exit_time, shell_exit_time_accelerated
 from sim.pipeline.input_checks import ConfigError
 
-KEYWORDS = {"gravity": (None, "[gx, gy] uniform acceleration (:mod:`sim.effects.gravity`); "
-                              "None or zero = off")}
+KEYWORDS = {"gravity": (None, "[gx, gy] uniform acceleration, two finite numbers "
+                              "(:mod:`sim.effects.gravity`), zero along a periodic axis; None "
+                              "or zero = off")}
 
 
 def check_config(cfg):
@@ -54,8 +56,8 @@ def loop_values(keywords, context):
     """g float64[2], None when zero; refused along a periodic axis of the ``context``."""
     gravity = gravity_vector(keywords["gravity"])
     if gravity is not None and np.any(gravity[context["periodic"]] != 0.0):
-        raise ValueError(f"gravity {gravity.tolist()} has a component along a periodic "
-                         f"axis, where nothing stops the fall; give it walls")
+        raise refused("Engine", "gravity", keywords["gravity"], "no component along a periodic "
+                      "axis, where nothing stops the fall; give it walls", show=True)
     return {"gravity": gravity}
 
 
@@ -63,9 +65,8 @@ def gravity_vector(gravity):
     """float64[2] for the compiled loop, or None when the scene has no gravity."""
     if gravity is None:
         return None
-    g = np.array(gravity, dtype=np.float64).reshape(-1)
-    if g.shape != (2,) or not np.all(np.isfinite(g)):
-        raise ValueError(f"gravity must be two finite numbers [gx, gy], got {gravity!r}")
+    g = shaped_reals("Engine", "gravity", gravity, ((2,),), np.isfinite,
+                     "two finite numbers [gx, gy], or None")
     return None if not np.any(g) else g
 
 

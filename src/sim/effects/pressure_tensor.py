@@ -10,9 +10,10 @@ Liquids*, 2nd ed., §2.4 and §3.7), whose trace is twice the pressure. None whe
 import numpy as np
 
 from sim.effects.rules import effect_rule
+from sim.engine.inputs import refused
 
-KEYWORDS = {"pressure_tensor": (False, "accumulate the collision virial tensor Σ r_a Δp_b "
-                                       "(:attr:`virial_tensor`)")}
+KEYWORDS = {"pressure_tensor": (False, "True or False: accumulate the collision virial tensor "
+                                       "Σ r_a Δp_b (:attr:`virial_tensor`)")}
 
 
 def check_config(cfg):
@@ -26,7 +27,15 @@ def engine_arguments(cfg):
 
 def loop_values(keywords, context):
     """The virial tensor float64[3] at zero, or None."""
-    return {"virial_tensor": np.zeros(3) if keywords["pressure_tensor"] else None}
+    return {"virial_tensor": np.zeros(3) if observed(keywords["pressure_tensor"]) else None}
+
+
+def observed(pressure_tensor):
+    """The keyword ``pressure_tensor`` as a bool: True or False (numpy's too), a ValueError
+    of ``Engine(pressure_tensor=…)`` otherwise."""
+    if not isinstance(pressure_tensor, bool | np.bool_):
+        raise refused("Engine", "pressure_tensor", pressure_tensor, "True or False")
+    return bool(pressure_tensor)
 
 
 def _not_observed(virial_tensor, rx, ry, virial):

@@ -22,19 +22,23 @@ import numpy as np
 
 from sim.effects.rotation import dissipates
 from sim.effects.rules import effect_rule
+from sim.engine.inputs import real_number, refused, shaped_reals, whole_count
 from sim.engine.parameters import per_disk
 from sim.pipeline.input_checks import within
 
 KEYWORDS = {
-    "restitution": (None, "scalar or (s, s) normal restitution ξ per species pair; 1 = elastic"),
-    "wall_restitution": (None, "ξ_w for every wall; 1 = elastic"),
-    "collapse_interval": (None, "inelastic-collapse detector: dissipative contacts of one disk "
-                          "each within this time of the one before make a streak. The default "
+    "restitution": (None, "scalar or (s, s) symmetric normal restitution ξ per species pair, in "
+                          "[0, 1]; 1 = elastic"),
+    "wall_restitution": (None, "ξ_w in [0, 1] for every wall; 1 = elastic"),
+    "collapse_interval": (None, "inelastic-collapse detector, a finite time > 0: dissipative "
+                          "contacts of one disk each within this time of the one before make "
+                          "a streak. The default "
                           "is 1e-6 of the time a disk at the initial rms speed takes to cross "
                           "its own diameter; in a gas, even a dense one, a run of ten such "
                           "intervals is far too unlikely ever to be seen, while a collapsing "
                           "cluster shrinks its intervals geometrically through that scale"),
-    "collapse_streak": (10, "a streak longer than this many contacts is inelastic collapse "
+    "collapse_streak": (10, "a streak longer than this many contacts (a whole number from 0 "
+                            "to 2^62) is inelastic collapse "
                             "(:class:`sim.engine.errors.InelasticCollapseError`)"),
 }
 
@@ -57,15 +61,20 @@ def loop_values(keywords, context):
     before it); its default interval from the scene's initial rms speed and median radius."""
     restitution = restitution_matrix(keywords["restitution"], context["n_species"])
     wall_restitution = wall_restitution_value(keywords["wall_restitution"])
+    interval, longest = keywords["collapse_interval"], keywords["collapse_streak"]
+    if interval is not None:
+        interval = real_number("Engine", "collapse_interval", interval,
+                               lambda t: 0.0 < t < math.inf,
+                               "a finite time > 0, or None (from the initial rms speed)")
+    longest = whole_count("Engine", "collapse_streak", longest)
     collapse = None
     if (restitution is not None or wall_restitution is not None
             or dissipates(context["roughness"], context["friction"])):
         energy, mass = context["initial_energy"], context["mass"]
         v_rms = math.sqrt(2.0 * energy / mass.sum()) if energy else 1.0
         crossing_time = 2.0 * float(np.median(context["radius"])) / v_rms
-        interval = keywords["collapse_interval"]
-        collapse = CollapseWatch(1e-6 * crossing_time if interval is None else float(interval),
-                                 int(keywords["collapse_streak"]))
+        collapse = CollapseWatch(1e-6 * crossing_time if interval is None else interval,
+                                 longest)
     return {"restitution": restitution, "wall_restitution": wall_restitution,
             "collapse": collapse}
 
@@ -75,15 +84,16 @@ def restitution_matrix(restitution, n_species):
     dropped), else a symmetric float64[s, s] with entries in [0, 1]."""
     if restitution is None:
         return None
-    xi = np.asarray(restitution, dtype=np.float64)
-    if xi.ndim != 0 and xi.shape != (n_species, n_species):
-        raise ValueError(f"restitution must be one number or a {n_species} × {n_species} "
-                         f"matrix (a row and a column per species), got shape {xi.shape}")
-    xi = np.broadcast_to(xi, (n_species, n_species))
-    if not np.all((xi >= 0.0) & (xi <= 1.0)):
-        raise ValueError(f"restitution must lie in [0, 1], got {xi.tolist()}")
+    s = n_species
+    xi = shaped_reals("Engine", "restitution", restitution, ((), (s, s)),
+                      lambda x: (x >= 0.0) & (x <= 1.0),
+                      f"one number or a symmetric {s} × {s} matrix (a row and a column per "
+                      f"species) of values in [0, 1] (1 = elastic), or None")
+    xi = np.broadcast_to(xi, (s, s))
     if not np.array_equal(xi, xi.T):
-        raise ValueError(f"restitution matrix must be symmetric, got {xi.tolist()}")
+        raise refused("Engine", "restitution", restitution,
+                      f"a symmetric {s} × {s} matrix: ξ of the pair (a, b) is that of (b, a)",
+                      show=xi.size <= 4)
     if np.all(xi == 1.0):
         return None
     # always a fresh writable copy: numba types read-only arrays apart, so a view passed on
@@ -93,10 +103,11 @@ def restitution_matrix(restitution, n_species):
 
 def wall_restitution_value(wall_restitution):
     """ξ_w for the compiled loop: None for elastic walls, else a float in [0, 1)."""
-    if wall_restitution is not None and not 0.0 <= wall_restitution <= 1.0:
-        raise ValueError(f"wall_restitution must lie in [0, 1], got {wall_restitution}")
-    return (None if wall_restitution is None or wall_restitution == 1.0
-            else float(wall_restitution))
+    if wall_restitution is None:
+        return None
+    xi = real_number("Engine", "wall_restitution", wall_restitution,
+                     lambda x: 0.0 <= x <= 1.0, "a number in [0, 1] (1 = elastic), or None")
+    return None if xi == 1.0 else xi
 
 
 class CollapseWatch(NamedTuple):

@@ -54,8 +54,10 @@ import numpy as np
 from numba import njit
 from omegaconf import OmegaConf
 
+from sim.effects.pressure_tensor import observed
 from sim.effects.rules import effect_rule
-from sim.effects.thermal_walls import is_thermal
+from sim.effects.thermal_walls import is_thermal, seed_value
+from sim.engine.inputs import real_number, refused, shaped_reals
 from sim.engine.kinematics import RADIUS, VX, VY
 from sim.pipeline.input_checks import ConfigError, positive, within
 
@@ -66,19 +68,21 @@ SMOOTH = -1.0
 SPIN_STREAM = 0x5EED5
 
 KEYWORDS = {
-    "tangential_restitution": (None, "scalar or (s, s) tangential restitution β per species "
-                               "pair in [−1, 1] (β₀ of Walton's model with friction): −1 = "
-                               "smooth, 1 = perfectly rough"),
+    "tangential_restitution": (None, "scalar or (s, s) symmetric tangential restitution β per "
+                               "species pair in [−1, 1] (β₀ of Walton's model with friction): "
+                               "−1 = smooth, 1 = perfectly rough"),
     "wall_tangential_restitution": (None, "β_w in [−1, 1], one for every wall or [4] (left, "
                                     "right, bottom, top); −1 = smooth"),
-    "friction": (None, "scalar or (s, s) Coulomb friction coefficient μ_f ≥ 0 per species "
-                 "pair (Walton's model); None = constant β"),
-    "wall_friction": (None, "μ_f of the walls, one or [4]; None = constant β_w"),
-    "inertia_factor": (0.5, "q of the moment of inertia I = q m a² (1/2 uniform disk, 1 ring)"),
-    "spin": (None, "initial angular velocities ω float64[n] (counter-clockwise positive); "
-                   "default all 0"),
+    "friction": (None, "scalar or (s, s) symmetric Coulomb friction coefficient μ_f per species "
+                 "pair, finite and ≥ 0 (Walton's model; needs β₀ > −1); None = constant β"),
+    "wall_friction": (None, "μ_f of the walls, finite and ≥ 0, one or [4]; None = constant β_w"),
+    "inertia_factor": (0.5, "q of the moment of inertia I = q m a², in (0, 1] (1/2 uniform "
+                            "disk, 1 ring)"),
+    "spin": (None, "initial angular velocities ω float64[n] or one for all, finite "
+                   "(counter-clockwise positive); default all 0"),
     "rotational_temperature": (0.0, "initial spins drawn from the Maxwellian at this T_rot = "
-                               "⟨I ω²⟩ (keyed by ``seed``), instead of ``spin``"),
+                               "⟨I ω²⟩, finite and ≥ 0 (keyed by ``seed``), instead of "
+                               "``spin``"),
 }
 
 
@@ -138,45 +142,77 @@ def engine_arguments(cfg):
             "rotational_temperature": float(cfg.disks.rotational_temperature)}
 
 
-def _pairs(value, n_species, default, name):
-    matrix = np.array(np.broadcast_to(np.asarray(default if value is None else value,
-                                                 dtype=np.float64), (n_species, n_species)))
+#: what β and μ_f may be: (accept elementwise, the words)
+BETA = (lambda x: (x >= -1.0) & (x <= 1.0), "values in [−1, 1] (−1 smooth, 1 perfectly rough)")
+MU = (lambda x: (x >= 0.0) & (x < math.inf), "finite values ≥ 0")
+
+
+def _pairs(value, n_species, default, name, values):
+    """The keyword ``name``: None (every pair ``default``), one number or a symmetric
+    (s, s) matrix of ``values`` (:data:`BETA`, :data:`MU`), as float64[s, s]."""
+    s = n_species
+    if value is None:
+        return np.full((s, s), default)
+    accept, words = values
+    matrix = np.array(np.broadcast_to(shaped_reals(
+        "Engine", name, value, ((), (s, s)), accept,
+        f"one number or a symmetric {s} × {s} matrix (a row and a column per species) of "
+        f"{words}, or None"), (s, s)))
     if not np.array_equal(matrix, matrix.T):
-        raise ValueError(f"{name} matrix must be symmetric, got {matrix.tolist()}")
+        raise refused("Engine", name, value, f"a symmetric {s} × {s} matrix: the value of "
+                                             f"the pair (a, b) is that of (b, a)",
+                      show=matrix.size <= 4)
     return matrix
 
 
-def _walls(value, default):
-    return np.array(np.broadcast_to(np.asarray(default if value is None else value,
-                                               dtype=np.float64), (4,)))
+def _walls(value, default, name, values):
+    """The keyword ``name``: None (every wall ``default``), one number or four (left, right,
+    bottom, top) of ``values``, as float64[4]."""
+    if value is None:
+        return np.full(4, default)
+    accept, words = values
+    return np.array(np.broadcast_to(shaped_reals(
+        "Engine", name, value, ((), (4,)), accept,
+        f"one number for every wall or four (left, right, bottom, top) of {words}, or None"),
+        (4,)))
 
 
 def loop_values(keywords, context):
     """Roughness, friction and the spins (None when every contact is smooth and no disk
-    turns); the initial spins from ``spin`` or drawn at ``rotational_temperature``. Friction
-    on smooth contacts (β₀ = −1 never sticks), wall values in a box without walls and the
-    pressure tensor of rough contacts (their impulses make it asymmetric) are refused."""
+    turns); the initial spins from ``spin`` or drawn at ``rotational_temperature``. Each
+    keyword is checked as :data:`KEYWORDS` says, naming it; friction on smooth contacts (β₀ =
+    −1 never sticks), wall values in a box without walls and the pressure tensor of rough
+    contacts (their impulses make it asymmetric) are refused."""
     s = context["n_species"]
-    beta = _pairs(keywords["tangential_restitution"], s, SMOOTH, "tangential_restitution")
-    beta_wall = _walls(keywords["wall_tangential_restitution"], SMOOTH)
-    mu = _pairs(keywords["friction"], s, math.inf, "friction")
-    mu_wall = _walls(keywords["wall_friction"], math.inf)
-    q = float(keywords["inertia_factor"])
-    if np.all(context["periodic"]) and (np.any(beta_wall > SMOOTH)
-                                        or keywords["wall_friction"] is not None):
-        raise ValueError("a periodic box has no walls for wall_tangential_restitution or "
-                         "wall_friction")
+    beta = _pairs(keywords["tangential_restitution"], s, SMOOTH, "tangential_restitution",
+                  BETA)
+    beta_wall = _walls(keywords["wall_tangential_restitution"], SMOOTH,
+                       "wall_tangential_restitution", BETA)
+    mu = _pairs(keywords["friction"], s, math.inf, "friction", MU)
+    mu_wall = _walls(keywords["wall_friction"], math.inf, "wall_friction", MU)
+    q = real_number("Engine", "inertia_factor", keywords["inertia_factor"],
+                    lambda x: 0.0 < x <= 1.0,
+                    "q = I/(m a²) in (0, 1] (1/2 uniform disk, 1 ring)")
+    if np.all(context["periodic"]):
+        for name, given in (("wall_friction", keywords["wall_friction"] is not None),
+                            ("wall_tangential_restitution", np.any(beta_wall > SMOOTH))):
+            if given:
+                raise refused("Engine", name, keywords[name], "None: a periodic box has no "
+                                                              "walls", show=True)
     for b, m in zip((*beta.ravel(), *beta_wall), (*mu.ravel(), *mu_wall), strict=True):
         rough_parameters(b, None if m == math.inf else m, q)
     for given, sticking, name in ((keywords["friction"], beta, "friction"),
                                   (keywords["wall_friction"], beta_wall, "wall_friction")):
         if given is not None and np.all(sticking == SMOOTH):
-            raise ValueError(f"{name} needs a sticking tangential restitution β₀ > −1 (β₀ = "
-                             f"−1 never sticks: the contact stays smooth whatever μ_f)")
+            raise refused("Engine", name, given, "None with smooth contacts: friction needs a "
+                                                 "sticking tangential restitution β₀ > −1 (β₀ = "
+                                                 "−1 never sticks: the contact stays smooth "
+                                                 "whatever μ_f)", show=True)
     rough = bool(np.any(beta > SMOOTH) or np.any(beta_wall > SMOOTH))
-    if rough and keywords["pressure_tensor"]:
-        raise ValueError("the pressure tensor of rough disks is not computed (the tangential "
-                         "impulses make the collision stress asymmetric)")
+    if rough and observed(keywords["pressure_tensor"]):
+        raise refused("Engine", "pressure_tensor", keywords["pressure_tensor"],
+                      "False with rough disks: the pressure tensor of rough disks is not "
+                      "computed (the tangential impulses make the collision stress asymmetric)")
     spin = initial_spins(keywords, context, q)
     if not rough and not np.any(spin):
         return {"roughness": None, "friction": None, "spin": None}
@@ -194,23 +230,27 @@ def dissipates(roughness, friction):
 
 
 def initial_spins(keywords, context, q):
-    """float64[n]: ``spin`` as given, or Maxwellian at ``rotational_temperature`` (keyed by
-    ``seed``; zero at T = 0)."""
-    n, temperature = context["n"], float(keywords["rotational_temperature"])
+    """float64[n]: ``spin`` as given (one finite number or n), or Maxwellian at
+    ``rotational_temperature`` (finite and ≥ 0; keyed by ``seed``; zero at T = 0); each
+    checked, naming it."""
+    n = context["n"]
+    temperature = real_number("Engine", "rotational_temperature",
+                              keywords["rotational_temperature"],
+                              lambda t: 0.0 <= t < math.inf,
+                              "a finite temperature ≥ 0 (0: spins at rest or as ``spin``)")
     if keywords["spin"] is not None:
+        spin = shaped_reals("Engine", "spin", keywords["spin"], ((), (n,)), np.isfinite,
+                            f"one finite number or n = {n} of them (each spin must be a finite "
+                            f"angular velocity), or None")
         if temperature:
-            raise ValueError("give the initial spins or a rotational temperature, not both")
-        spin = np.asarray(keywords["spin"], dtype=np.float64)
-        if spin.shape not in ((), (n,)) or not np.all(np.isfinite(spin)):
-            raise ValueError(f"spin must be one finite number or n = {n} of them, got shape "
-                             f"{spin.shape}")
+            raise refused("Engine", "rotational_temperature", keywords["rotational_temperature"],
+                          "0 when ``spin`` is given: give the initial spins or a rotational "
+                          "temperature, not both")
         return np.array(np.broadcast_to(spin, (n,)))
-    if not 0.0 <= temperature < math.inf:
-        raise ValueError(f"rotational_temperature must be finite and ≥ 0, got {temperature}")
     if not temperature:
         return np.zeros(n)
     inertia = moment_of_inertia(q, context["mass"], context["radius"])
-    rng = np.random.default_rng([int(keywords["seed"]), SPIN_STREAM])
+    rng = np.random.default_rng([seed_value(keywords["seed"]), SPIN_STREAM])
     return maxwellian_spins(rng, temperature, inertia)
 
 

@@ -16,9 +16,10 @@ floor under gravity leaves it as from a bounce lasting t_c
 import math
 
 from sim.effects.rules import effect_rule
+from sim.engine.inputs import real_number
 from sim.pipeline.input_checks import positive
 
-KEYWORDS = {"tc": (None, "TC-model time t_c (None or 0 = off)")}
+KEYWORDS = {"tc": (None, "TC-model time t_c, finite and ≥ 0 (None or 0 = off)")}
 
 
 def check_config(cfg):
@@ -40,9 +41,10 @@ def loop_values(keywords, context):
 def tc_time(tc, dissipative):
     """t_c for the compiled loop: None when the model is off (None or 0) or no contact
     dissipates, else a finite float > 0."""
-    if tc is not None and not 0.0 <= tc < math.inf:
-        raise ValueError(f"tc (the TC-model time) must be finite and ≥ 0, or None; got {tc}")
-    return float(tc) if (tc and dissipative) else None
+    if tc is not None:
+        tc = real_number("Engine", "tc", tc, lambda t: 0.0 <= t < math.inf,
+                         "the TC-model time t_c, finite and ≥ 0, or None (None or 0 = off)")
+    return tc if (tc and dissipative) else None
 
 
 def _off(tc, xi, t, t_last_i, t_last_j):

@@ -13,14 +13,13 @@ numbers as one never interrupted.
 """
 
 import math
-import operator
 
 import numpy as np
 from numba import njit
 
 from sim.effects.rules import effect_rule
 from sim.engine.box import WALL_NAMES
-from sim.engine.inputs import WALLS, wall_specs
+from sim.engine.inputs import WALLS, wall_keyword, whole_count
 from sim.engine.kinematics import INF, VX
 from sim.pipeline.input_checks import positive, walled
 
@@ -29,9 +28,9 @@ _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX_2 = np.uint64(0x94D049BB133111EB)
 
 
-KEYWORDS = {"seed": (0, "keys the random draws of thermal walls and of the initial spins "
-                        "(same seed, same bits); the walls' temperatures are given with "
-                        "``walls``")}
+KEYWORDS = {"seed": (0, "a whole number from 0 to 2^63 - 1 that keys the random draws of "
+                        "thermal walls and of the initial spins (same seed, same bits); the "
+                        "walls' temperatures are given with ``walls``")}
 
 
 def check_config(cfg):
@@ -50,19 +49,15 @@ def engine_arguments(cfg):
 
 def loop_values(keywords, context):
     """T_w per wall (None when no wall is thermal), and the seed."""
-    temperature = wall_temperature(wall_specs(keywords["walls"], context["periodic"]))
+    temperature = wall_temperature(wall_keyword(keywords["walls"], context["periodic"]))
     return {"wall_temperature": temperature, "seed": seed_value(keywords["seed"])}
 
 
 def seed_value(seed):
-    """The seed as the compiled generator takes it (int64 ≥ 0)."""
-    try:
-        value = operator.index(seed)
-    except TypeError:
-        value = None
-    if value is None or not 0 <= value <= np.iinfo(np.int64).max:
-        raise ValueError(f"seed must be an integer in [0, 2**63 - 1], got {seed!r}")
-    return value
+    """The seed as the compiled generator takes it (int64 ≥ 0): a whole number from 0 to
+    2^63 − 1 (a float that is one too, such as 1e6); the ValueError of ``Engine(seed=…)``
+    otherwise (:func:`sim.engine.inputs.whole_count`)."""
+    return whole_count("Engine", "seed", seed, high=int(np.iinfo(np.int64).max))
 
 
 def wall_temperature(walls):

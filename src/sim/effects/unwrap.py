@@ -10,9 +10,10 @@ loop holds no code for it.
 import numpy as np
 
 from sim.effects.rules import effect_rule
+from sim.engine.inputs import refused
 
-KEYWORDS = {"unwrap": (False, "count periodic windings, for :meth:`unwrapped_positions` (mean "
-                              "squared displacements)")}
+KEYWORDS = {"unwrap": (False, "True or False: count periodic windings, for "
+                              ":meth:`unwrapped_positions` (mean squared displacements)")}
 
 
 def check_config(cfg):
@@ -25,9 +26,11 @@ def engine_arguments(cfg):
 
 
 def loop_values(keywords, context):
-    """Winding counts int32[n, 2] at zero, or None."""
-    return {"images": np.zeros((context["n"], 2), dtype=np.int32) if keywords["unwrap"]
-            else None}
+    """Winding counts int32[n, 2] at zero, or None; ``unwrap`` a bool (numpy's too)."""
+    unwrap = keywords["unwrap"]
+    if not isinstance(unwrap, bool | np.bool_):
+        raise refused("Engine", "unwrap", unwrap, "True or False")
+    return {"images": np.zeros((context["n"], 2), dtype=np.int32) if unwrap else None}
 
 
 def _not_counted(images, i, axis, x, folded):

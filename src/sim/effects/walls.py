@@ -24,7 +24,7 @@ from sim.effects.gravity import acceleration, resting_lift
 from sim.effects.rules import effect_rule
 from sim.effects.thermal_walls import thermal_redraw
 from sim.engine.box import SIDE, WALL_NAMES
-from sim.engine.inputs import WALLS, wall_specs
+from sim.engine.inputs import WALLS, wall_keyword
 from sim.engine.kinematics import (
     INF,
     RADIUS,
@@ -47,8 +47,9 @@ CONTACT_TOLERANCE = 1e-15
 
 KEYWORDS = {"walls": (None, '{"left" | "right" | "bottom" | "top": {"temperature": T_w, '
                             '"speed": U, "amplitude": A, "frequency": ω}} — thermal, moving and '
-                            "vibrating walls (:mod:`sim.effects.walls`); absent keys keep the "
-                            "wall hard and still")}
+                            "vibrating walls (:mod:`sim.effects.walls`): T_w finite and > 0 (or "
+                            "None), U finite, A and ω finite and ≥ 0 (ω > 0 with A > 0); absent "
+                            "walls and keys keep the wall hard and still")}
 
 
 def check_config(cfg):
@@ -78,8 +79,9 @@ def engine_arguments(cfg):
 
 
 def loop_values(keywords, context):
-    """(U, A, ω) per wall, None when no wall moves."""
-    return {"wall_motion": wall_motion(wall_specs(keywords["walls"], context["periodic"]))}
+    """(U, A, ω) per wall, None when no wall moves (``walls`` checked by
+    :func:`sim.engine.inputs.wall_keyword`)."""
+    return {"wall_motion": wall_motion(wall_keyword(keywords["walls"], context["periodic"]))}
 
 
 def wall_motion(walls):

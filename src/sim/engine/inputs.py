@@ -4,7 +4,9 @@ is allowed."""
 
 import math
 import operator
+from collections.abc import Mapping
 from dataclasses import dataclass
+from numbers import Real
 
 import numpy as np
 
@@ -104,19 +106,49 @@ def check_inside(given, position, radius, box, periodic):
                                  f"radius R needs R ≤ x ≤ L − R")
 
 
-def wall_specs(walls, periodic):
-    """``walls`` as :class:`Engine` takes them (name → {key: value}), checked and keyed by
-    wall number (:mod:`sim.effects.walls`); walls without an entry stay hard and still."""
-    walls = {} if walls is None else dict(walls)
+def wall_keyword(walls, periodic):
+    """``walls`` as :class:`Engine` takes them (None, or a mapping of wall names to None or
+    to {key: value} of :data:`WALL_KEYS`), checked and keyed by wall number: temperature None
+    or finite and > 0, speed finite, amplitude and frequency finite and ≥ 0, a frequency > 0
+    for an amplitude > 0, no entry on a periodic axis; a ValueError of ``Engine(walls=…)``
+    naming the wall and key at fault otherwise. Walls without an entry stay hard and still."""
+    def refuse(allowed):
+        return refused("Engine", "walls", walls, allowed)
+
+    if walls is None:
+        return {}
+    if not isinstance(walls, Mapping):
+        raise refuse(f"None or a mapping of wall names ({', '.join(WALLS)}) to their keys")
+    specs = {}
     for name, spec in walls.items():
         if name not in WALLS:
-            raise ValueError(f"unknown wall {name!r}: use {', '.join(WALLS)}")
-        unknown = sorted(set(spec or {}) - set(WALL_KEYS))
+            raise refuse(f"unknown wall {name!r}: use {', '.join(WALLS)}")
+        if spec is not None and not isinstance(spec, Mapping):
+            raise refuse(f"{name} wall: None or a mapping of {', '.join(WALL_KEYS)} to numbers")
+        spec = dict(spec or {})
+        unknown = sorted(set(spec) - set(WALL_KEYS), key=str)
         if unknown:
-            raise ValueError(f"{name} wall: unknown keys {unknown}, use {', '.join(WALL_KEYS)}")
+            raise refuse(f"{name} wall: unknown keys {unknown}, use {', '.join(WALL_KEYS)}")
         if spec and periodic[WALLS[name] >> 1]:
-            raise ValueError(f"{name} wall is given on a periodic axis, which has no walls")
-    return {WALLS[name]: dict(spec) for name, spec in walls.items() if spec}
+            raise refuse(f"{name} wall is given on a periodic axis, which has no walls")
+        checked = {}
+        for key, accept, allowed in (
+                ("temperature", lambda t: 0.0 < t < math.inf, "must be finite and > 0, or None"),
+                ("speed", math.isfinite, "must be finite"),
+                ("amplitude", lambda a: 0.0 <= a < math.inf, "must be finite and ≥ 0"),
+                ("frequency", lambda w: 0.0 <= w < math.inf, "must be finite and ≥ 0")):
+            if key not in spec or (key == "temperature" and spec[key] is None):
+                continue
+            value = spec[key]
+            if (isinstance(value, bool | np.bool_) or not isinstance(value, Real)
+                    or not accept(float(value))):
+                raise refuse(f"{name} wall: {key} {_plain(value)!r} {allowed}")
+            checked[key] = float(value)
+        if checked.get("amplitude", 0.0) > 0.0 and checked.get("frequency", 0.0) == 0.0:
+            raise refuse(f"{name} wall: an angular frequency > 0 for a wall with an amplitude")
+        if spec:
+            specs[WALLS[name]] = {**spec, **checked}
+    return specs
 
 
 #: float64 squares and multiplies the scales of a scene in its roots, impulses and energies:
@@ -260,6 +292,23 @@ def real_array(call, name, value, accept=None, allowed=""):
     if bad is not None:
         raise ValueError(f"{call}({name}=…) is not allowed: entry {bad} is "
                          f"{float(array.ravel()[bad])!r}; {allowed}")
+    return array
+
+
+def shaped_reals(call, name, value, shapes, accept, allowed):
+    """``value`` as a float64 array of one of the ``shapes`` (``()`` for one number) whose
+    every entry ``accept`` takes (elementwise, on the array); a ValueError naming ``name`` of
+    ``call`` and saying ``allowed`` otherwise (text, booleans, complex numbers, lists of
+    unequal lengths and other shapes included). Values of up to four numbers are shown."""
+    try:
+        kind, show = np.asarray(value).dtype.kind, np.size(value) <= 4
+    except ValueError:  # lists of unequal lengths
+        kind, show = "O", False
+    if kind not in "iuf":
+        raise refused(call, name, value, allowed, show=show)
+    array = np.array(value, dtype=np.float64, order="C")
+    if array.shape not in shapes or not np.all(accept(array)):
+        raise refused(call, name, value, allowed, show=show)
     return array
 
 
