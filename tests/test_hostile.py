@@ -345,6 +345,8 @@ BAD_INPUT = {
     "flag-config-path": ("-cp /tmp", "--config-path"),
     "flag-config-dir": ("--config-dir /nonexistent", "--config-dir"),
     "hydra-mode": ("hydra.mode=MULTIRUN disks.n=100,120", "hydra.mode"),
+    "flag-resolve-without-cfg": ("--resolve", "--resolve"),
+    "flag-package": ("--cfg job -p nope", "--package"),
 }
 
 

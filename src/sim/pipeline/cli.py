@@ -190,6 +190,9 @@ def main():
         try:
             with guard:
                 hydra_main()
+            if sweeping:  # the sweep is over: a late signal must not break the report
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+                signal.signal(signal.SIGTERM, signal.SIG_IGN)
         except SystemExit as stop:
             if stop.code not in (0, None):
                 remove_made_folders()  # those still empty: a refusal leaves none behind

@@ -64,7 +64,10 @@ def hydra_arguments(args):
                 if given]
     if len(commands) > 1:  # Hydra's own check, a ValueError traceback there
         refuse(f"{' and '.join(commands)} together; only one of them may be given")
-    for flag, given in (("--config-path", known.config_path),
+    if known.resolve and not known.cfg:  # Hydra's own check, a ValueError traceback there
+        refuse("--resolve without --cfg; it resolves what --cfg prints")
+    for flag, given in (("--package", known.package),
+                        ("--config-path", known.config_path),
                         ("--config-name", known.config_name),
                         ("--config-dir", known.config_dir),
                         ("--experimental-rerun", known.experimental_rerun),

@@ -19,6 +19,7 @@ would break joblib's pool, killing the jobs still writing) nor is lost. The laun
 no more workers than jobs (:func:`worker_count`).
 """
 
+import contextlib
 import os
 import signal
 import threading
@@ -68,7 +69,8 @@ POLL_SECONDS = 0.1
 @contextmanager
 def guarded(sweep_dir, taken, at_second_signal):
     """The sweep's process inside the block, which starts its workers: the first SIGINT or
-    SIGTERM is ``taken(signal)`` and :func:`request`, a second ``at_second_signal(signal)``.
+    SIGTERM is ``taken(signal)`` and :func:`request`; a second ends the workers at once
+    (SIGKILL) and is ``at_second_signal(signal)``.
     Both signals are blocked in this thread, so that the threads it starts and the workers
     they spawn inherit them blocked (a worker between jobs then outlives a signal to its
     process group); a thread of their own waits for them, and the handler takes those that
@@ -76,7 +78,10 @@ def guarded(sweep_dir, taken, at_second_signal):
     count = []
 
     def take(signum):
-        if count:
+        if count:  # at once, as for a single run: the workers too
+            for pid in _children():
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(pid, signal.SIGKILL)
             at_second_signal(signal.Signals(signum))
         count.append(signum)
         taken(signal.Signals(signum))
@@ -103,6 +108,19 @@ def guarded(sweep_dir, taken, at_second_signal):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
         for number, handling in previous.items():
             signal.signal(number, handling)
+
+
+def _children():
+    """The pids of this process's children (from /proc)."""
+    mine = str(os.getpid())
+    pids = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            if stat.read_text().rpartition(")")[2].split()[1] == mine:
+                pids.append(int(stat.parent.name))
+        except (OSError, IndexError):  # ended meanwhile
+            continue
+    return pids
 
 
 @contextmanager
