@@ -5,18 +5,17 @@ SIGINT or SIGTERM to the sweep's process (``python -m sim … -m``), to a worker
 jobs, or to all of them at once (Ctrl-C in a terminal, a scheduler's time limit) writes the
 signal's name into the stop file :data:`STOP_FILE` of the sweep folder (:func:`request`). A
 running job watches for it between compiled chunks as for a signal of its own
-(:attr:`sim.pipeline.interruption.Interruption.stop_file`) and ends as ``interrupted`` or
+(:attr:`sim.pipeline.interruption.Interruption.sweep_dir`) and ends as ``interrupted`` or
 ``terminated``; a job that starts after it runs nothing. Stopped jobs return, not raise, so
 that the launcher waits for the others (joblib ends a pool at a job's exception, killing the
 jobs still writing); the sweep's process then exits with 128 + the signal's number, and
 clears the stop file (:func:`clear`), as does the next sweep into the folder. A second
-signal stops at once, as SIGKILL would.
+signal to the sweep's process ends it and its workers at once, as SIGKILL would.
 
-The sweep's process blocks both signals before its workers start and takes them in a thread
-of its own (:func:`guarded`): workers inherit them blocked, and a job unblocks them while
-it runs (:func:`job`), so that a signal to a worker between two jobs neither kills it (which
-would break joblib's pool, killing the jobs still writing) nor is lost. The launcher starts
-no more workers than jobs (:func:`worker_count`).
+The sweep's process takes both signals with a handler of its own (:func:`guarded`), a job
+with another while it runs (:func:`job`). A worker that has no job (starting up, or between
+two jobs) keeps Python's handlers, and a signal to it alone ends it and breaks joblib's pool;
+so the launcher starts no more workers than jobs (:func:`worker_count`).
 """
 
 import contextlib
@@ -62,22 +61,14 @@ def clear(sweep_dir):
 SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
-#: how often the sweep's signal thread looks whether the sweep is over (seconds)
-POLL_SECONDS = 0.1
-
-
 @contextmanager
 def guarded(sweep_dir, taken, at_second_signal):
-    """The sweep's process inside the block, which starts its workers: the first SIGINT or
-    SIGTERM is ``taken(signal)`` and :func:`request`; a second ends the workers at once
-    (SIGKILL) and is ``at_second_signal(signal)``.
-    Both signals are blocked in this thread, so that the threads it starts and the workers
-    they spawn inherit them blocked (a worker between jobs then outlives a signal to its
-    process group); a thread of their own waits for them, and the handler takes those that
-    reach threads started before. All is as it was after the block."""
+    """The sweep's process inside the block, which runs its jobs: the first SIGINT or SIGTERM
+    is ``taken(signal)`` and :func:`request`; a second ends the workers at once (SIGKILL)
+    and is ``at_second_signal(signal)``. The handlers are as they were after the block."""
     count = []
 
-    def take(signum):
+    def take(signum, frame):
         if count:  # at once, as for a single run: the workers too
             for pid in _children():
                 with contextlib.suppress(ProcessLookupError):
@@ -87,25 +78,10 @@ def guarded(sweep_dir, taken, at_second_signal):
         taken(signal.Signals(signum))
         request(sweep_dir, signum)
 
-    previous = {number: signal.signal(number, lambda signum, frame: take(signum))
-                for number in SIGNALS}
-    signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
-    over = threading.Event()
-
-    def wait():
-        while not over.is_set():
-            arrived = signal.sigtimedwait(SIGNALS, POLL_SECONDS)
-            if arrived is not None:
-                take(arrived.si_signo)
-
-    thread = threading.Thread(target=wait, name="sweep signals", daemon=True)
-    thread.start()
+    previous = {number: signal.signal(number, take) for number in SIGNALS}
     try:
         yield
     finally:
-        over.set()
-        thread.join()
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
         for number, handling in previous.items():
             signal.signal(number, handling)
 
@@ -125,10 +101,10 @@ def _children():
 
 @contextmanager
 def job(sweep_dir, at_second_signal):
-    """A job of the sweep in ``sweep_dir``, in a worker: SIGINT and SIGTERM, blocked between
-    jobs, reach it inside the block and ask the sweep to stop (:func:`request`; the run's
-    :class:`sim.pipeline.interruption.Interruption` takes them while it runs); a second one
-    to this process is ``at_second_signal(signal)``."""
+    """A job of the sweep in ``sweep_dir``: SIGINT and SIGTERM inside the block ask the sweep
+    to stop (:func:`request`; the run's :class:`sim.pipeline.interruption.Interruption`
+    takes them while it runs); a second one to this process is
+    ``at_second_signal(signal)``."""
     taken = []
 
     def handler(signum, frame):
@@ -140,12 +116,10 @@ def job(sweep_dir, at_second_signal):
     main = threading.current_thread() is threading.main_thread()
     if main:
         previous = {number: signal.signal(number, handler) for number in SIGNALS}
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
     try:
         yield
     finally:
         if main:
-            signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
             for number, handling in previous.items():
                 signal.signal(number, handling)
 
