@@ -281,6 +281,11 @@ BAD_INPUT = {
     "misspelt-disks.nn": ("disks.nn=3", "disks.nn"),
     "sweep-item-abc": ("stop.collisions=2e6,abc -m", "abc"),
     "sweep-item-nan": ("restitution.disk=0.5,nan -m", "restitution.disk"),
+    "delete-a-key": ("~seed", "~seed"),
+    "delete-a-stop-key": ("~stop.collisions", "stop.collisions=…"),
+    "sweep-jobs-in-one-folder": ("seed=0,1 hydra.sweep.subdir=same -m", "hydra.sweep.subdir"),
+    "sweep-jobs-in-one-folder-by-a-key": ("seed=0,1 disks.n=50,60 hydra.sweep.subdir=n${seed} -m",
+                                          "hydra.sweep.subdir"),
     # resources
     "memory-1e9-disks": ("disks.n=1000000000", "disks.n"),
     "memory-1e9-disks-run.dir": ("disks.n=1000000000 hydra.run.dir=X/run", "disks.n"),
@@ -362,6 +367,12 @@ def test_bad_input_is_refused_with_one_line_and_nothing_written(case, entry, tmp
     check(result, 2, [key], before, tree(tmp_path), nothing_new=True)
 
 
+def test_job_folders_named_by_a_swept_key_are_accepted(entry, tmp_path):
+    result = entry("seed=0,1", "hydra.sweep.subdir=seed_${seed}", f"hydra.sweep.dir={tmp_path}/S",
+                   "-m")
+    assert result.code == "not refused before Hydra started", result.err
+
+
 @pytest.mark.parametrize("flags", ["--cfg job", "--info", "--hydra-help", "--cfg all seed=3"])
 def test_flags_that_only_print_make_no_run_folder(flags, entry, tmp_path):
     """``--cfg job`` and the like reach Hydra, which prints and runs nothing: no folder is
@@ -435,6 +446,9 @@ NEVER = {
                                     "stop.time"),
     "time-beyond-2^62-collisions-sparse": ("disks.n=100 stop.collisions=null stop.time=1e50 "
                                            "output.every_time=1e49", "stop.time"),
+    "time-beyond-2^62-events-under-gravity": ("disks.n=100 gravity=[0,-1] restitution.disk=0.9 "
+                                              "restitution.wall=0.9 tc.time=1e-4 "
+                                              "stop.collisions=null stop.time=1e50", "stop.time"),
 }
 
 
@@ -727,7 +741,8 @@ def test_resume_after_a_kill_says_which_snapshots_it_computes_again(small_run, t
         f["checkpoint"].attrs["latest"] = first
         f["parameters"].attrs["stop_reason"] = "running"
     with pytest.warns(RuntimeWarning, match=rf"the {len(whole) - 1} snapshots written after "
-                                            rf"it, to t = .*, are dropped and computed again"):
+                                            rf"it, to t = .*, are dropped; the run goes on "
+                                            rf"from the checkpoint"):
         runner.resume(good)
     with h5py.File(good, "r") as f:
         np.testing.assert_array_equal(f["particles/disks/position/value"][()], whole)
@@ -1136,6 +1151,19 @@ def test_sigterm_ends_a_run_resumably_and_resume_finishes_it(tmp_path):
     assert not hidden_leftovers(tmp_path)
 
 
+def still_running(pids):
+    """Those of ``pids`` that run (neither ended nor zombies)."""
+    running = []
+    for pid in pids:
+        try:
+            state = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0]
+        except OSError:  # ended
+            continue
+        if state != "Z":
+            running.append(pid)
+    return running
+
+
 def descendants(pid):
     """The pids of every process under ``pid`` (from /proc)."""
     parents = {}
@@ -1183,8 +1211,108 @@ def test_a_signal_stops_a_sweep_whole(to, how, seeds, tmp_path):
     assert summary_["stopped"] == len(seeds.split(",")) and summary_["failed"] == 0
     assert not (tmp_path / "S" / "2" / "run.h5").exists()  # begun after the stop: nothing
     assert not (tmp_path / "S" / ".sweep-stop").exists()
-    assert not [pid for pid in workers if Path(f"/proc/{pid}").exists()
-                and "Z" not in Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2][:3]]
+    assert not still_running(workers)
+
+
+#: a ``sitecustomize`` for a sweep's processes: the first joblib worker that imports the
+#: module named by $SIGNAL_AT sends SIGINT to the process group, as Ctrl-C would, once; the
+#: moment is set by the program, not by a clock
+SIGNAL_AT_IMPORT = """
+import importlib.abc, os, signal, sys
+
+
+class AtImport(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name == os.environ["SIGNAL_AT"]:
+            sys.meta_path.remove(self)
+            try:
+                os.close(os.open(os.environ["SIGNAL_TOKEN"], os.O_CREAT | os.O_EXCL))
+            except FileExistsError:
+                return None
+            os.killpg(os.getpgid(0), signal.SIGINT)
+        return None
+
+
+if "--process-name" in sys.argv:  # loky's worker, not the sweep or a resource tracker
+    sys.meta_path.insert(0, AtImport())
+"""
+
+
+@pytest.mark.parametrize("moment", ["joblib", "hydra"])
+def test_ctrl_c_as_a_sweep_worker_starts_stops_the_sweep_in_one_line(moment, tmp_path):
+    """Ctrl-C while a worker starts (importing joblib, before it can take signals; importing
+    hydra, as it reads its first job): no worker dies of it, no traceback, exit 130, no job
+    run, no stop file left."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(SIGNAL_AT_IMPORT)
+    environment = {**os.environ, "SIGNAL_AT": moment, "SIGNAL_TOKEN": str(tmp_path / "token"),
+                   "PYTHONPATH": os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])}
+    result = sim(*FOREVER, "seed=0,1", "hydra.sweep.dir=S", "-m", cwd=tmp_path,
+                 env=environment, start_new_session=True,
+                 preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    assert (tmp_path / "token").exists()  # the signal was sent
+    check(result, 130, ["interrupted", "hydra.sweep.dir=S"])
+    assert not list((tmp_path / "S").glob("*/run.h5"))
+    assert not (tmp_path / "S" / ".sweep-stop").exists()
+
+
+def test_ctrl_c_while_a_worker_waits_between_jobs_ends_only_the_running_job(tmp_path):
+    """Ctrl-C to the process group when one worker has finished its jobs and another still
+    runs one: the idle worker ignores it (joblib's pool stays whole), the running job ends
+    with its final snapshot and checkpoint, exit 130."""
+    process = start("disks.n=2000", "output.every_collisions=20000",
+                    "stop.collisions=2000,100000000,2000", "hydra.sweep.dir=S", "-m",
+                    cwd=tmp_path, start_new_session=True,
+                    preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    statuses = [tmp_path / "S" / job / "job_status.yaml" for job in "02"]
+    try:
+        for path in [*statuses, tmp_path / "S" / "1" / "run.h5"]:
+            assert wait_for(path, process), finish(process).err[-2000:]
+    finally:
+        os.killpg(process.pid, signal.SIGINT)
+        result = finish(process)
+    check(result, 130, ["interrupted", "hydra.sweep.dir=S"])
+    assert stop_reason(tmp_path / "S" / "1" / "run.h5") == "interrupted"
+    assert [stop_reason(tmp_path / "S" / job / "run.h5") for job in "02"] == ["collisions"] * 2
+
+
+def test_a_worker_killed_outright_stops_its_sweep_in_one_line(tmp_path):
+    """kill -9 (the OOM killer) of a sweep's worker breaks joblib's pool, which kills the
+    others: one line naming the sweep folder to run again, exit 1, every run file whole."""
+    process = start(*FOREVER, "seed=0,1", "hydra.sweep.dir=S", "-m", cwd=tmp_path,
+                    start_new_session=True)
+    try:
+        for job in "01":
+            assert wait_for(tmp_path / "S" / job / "run.h5", process), finish(process).err
+    finally:
+        workers = [pid for pid in descendants(process.pid)
+                   if b"popen_loky" in Path(f"/proc/{pid}/cmdline").read_bytes()]
+        os.kill(workers[0], signal.SIGKILL)
+        result = finish(process)
+    check(result, 1, ["worker", "SIGKILL", "hydra.sweep.dir=S"])
+    for job in "01":
+        assert summary(tmp_path / "S" / job / "run.h5")["damaged"] == []
+
+
+def test_a_sweep_killed_outright_leaves_no_worker_computing(tmp_path):
+    """SIGKILL to a sweep's process (the OOM killer, kill -9): its workers end their jobs as
+    at SIGTERM, with final snapshot and checkpoint, and exit instead of computing for no
+    one."""
+    process = start(*FOREVER, "seed=0,1", "hydra.sweep.dir=S", "-m", cwd=tmp_path,
+                    start_new_session=True)
+    try:
+        for job in "01":
+            assert wait_for(tmp_path / "S" / job / "run.h5", process), finish(process).err
+    finally:
+        workers = descendants(process.pid)
+        process.kill()
+        finish(process)
+    deadline = time.monotonic() + HANG_GUARD
+    while still_running(workers):
+        assert time.monotonic() < deadline, "the workers of a killed sweep still run"
+        time.sleep(0.05)
+    assert {stop_reason(tmp_path / "S" / job / "run.h5") for job in "01"} == {"terminated"}
 
 
 #: ``python -m sim`` that sends itself SIGINT at a moment of its start-up, the first argument:

@@ -36,8 +36,9 @@ def test_random_placement_stays_in_its_region():
     assert position[:, 1].min() >= 0.0045
 
 
-def test_random_placement_error_reports_the_packing_reached():
-    with pytest.raises(PlacementError, match=r"stopped at packing fraction 0\.[45]\d\d"):
+def test_random_placement_error_names_radius_and_reports_the_packing_reached():
+    with pytest.raises(PlacementError, match=r"^random_sequential\(radius=…\) is not allowed: "
+                                             r".*stopped at packing fraction 0\.[45]\d\d"):
         random_sequential(np.full(2000, np.sqrt(0.6 / (2000 * np.pi))), seed=4)
 
 
@@ -78,8 +79,9 @@ def test_melted_lattice_is_a_fluid_without_overlap():
     np.testing.assert_array_equal(fluid, melted_lattice(n, radius, region=region, seed=5))
 
 
-def test_lattice_error_names_the_limit():
-    with pytest.raises(PlacementError, match="0.9069"):
+def test_lattice_error_names_radius_and_the_limit():
+    with pytest.raises(PlacementError, match=r"^hexagonal_lattice\(radius=.*\) is not allowed: "
+                                             r".*0\.9069"):
         hexagonal_lattice(1000, np.sqrt(0.93 / (1000 * np.pi)))
 
 

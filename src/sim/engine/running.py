@@ -103,10 +103,9 @@ class Running:
         ``energy_fraction``, none of which can ever hold, is refused too, as the command line
         refuses such a ``stop`` (:func:`sim.engine.inputs.check_reachable`):
         ``energy_fraction`` < 1 where no contact dissipates energy, a ``time`` beyond what the
-        2^62 events a run may count reach where the kinetic energy never changes
-        (:meth:`_latest_time`). The piston-jam guard (:meth:`_check_piston`)
-        runs after every chunk, whatever ended it. Chunk sizes change no result: the same
-        inputs give the same bits.
+        2^62 events a run may count reach where that is bounded (:meth:`latest_time`). The
+        piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended it.
+        Chunk sizes change no result: the same inputs give the same bits.
         """
         given = time, energy_fraction  # as written, for a refusal
         (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
@@ -161,34 +160,59 @@ class Running:
         :func:`check_stop` accepted."""
         others = (contacts, collisions, events, wall_seconds, until)
         if all(x is None for x in others) and (time is not None or energy_fraction is not None):
-            periodic_only = bool(np.all(self.periodic))
-            dissipating = (self.restitution is not None or dissipates(self.roughness, self.friction)
-                           or (self.wall_restitution is not None and not periodic_only))
+            dissipating = self.disk_contacts_dissipate or self.wall_contacts_dissipate
             met = (energy_fraction is not None and self.dissipated_energy
                    >= self.initial_energy * (1.0 - float(energy_fraction)))
-            check_reachable(time, energy_fraction, dissipating or met,
-                            *self._latest_time())
+            check_reachable(time, energy_fraction, dissipating or met, *self.latest_time())
 
-    def _latest_time(self):
+    @property
+    def disk_contacts_dissipate(self):
+        """Whether a contact of two disks can lose energy: inelastic, or rough with a loss."""
+        return self.restitution is not None or dissipates(self.roughness, self.friction)
+
+    @property
+    def wall_contacts_dissipate(self):
+        """Whether a contact with a wall can lose energy: inelastic walls in a box that has
+        walls."""
+        return self.wall_restitution is not None and not bool(np.all(self.periodic))
+
+    @property
+    def conserves_kinetic_energy(self):
+        """Whether the kinetic energy never changes: elastic smooth disks, elastic walls or
+        none, no gravity, still walls that are not thermal."""
+        return not (self.restitution is not None or self.wall_contacts_dissipate
+                    or self.roughness is not None or self.gravity is not None
+                    or self.wall_motion is not None or self.wall_temperature is not None)
+
+    def latest_time(self):
         """The latest time the engine can reach in the events left to it (2^62 in all), inf
-        where no bound is known. Bounded when the kinetic energy E never changes (elastic
-        smooth disks, elastic or no walls, no gravity, still walls that are not thermal):
-        the fastest disk, at least as fast as √(2E/M) (M the total mass), flies straight
-        across at most its shell's diameter 2 δ before its next event, so some event comes
-        at least every 2 δ √(M / 2E). Returns (that time, the reason in words)."""
-        walls = self.wall_restitution is not None and not np.all(self.periodic)
-        if (self.restitution is not None or walls or self.roughness is not None
-                or self.gravity is not None or self.wall_motion is not None
-                or self.wall_temperature is not None):
-            return math.inf, ""
+        where no bound is known, with the reason in words. Some event comes at least every
+
+        - 2 δ √(M / 2E) where the kinetic energy E never changes
+          (:attr:`conserves_kinetic_energy`; M the total mass): the fastest disk, at least
+          as fast as √(2E/M), flies straight across at most its shell's diameter 2 δ before
+          its next event;
+        - (2 + 2√2) √(δ/g) under gravity g, whatever the energy does: on a parabola the
+          displacement vt − gt²/2 along g leaves [−2δ, 2δ] by then from any speed v (the
+          slowest start, v just under 2√(gδ) upward, rises almost 2δ and takes that long
+          to fall to 2δ below).
+
+        Returns (that time, the reason in words)."""
+        delta = float(np.max(self.disks.delta))
+        gaps = {}
+        if self.gravity is not None:
+            g = float(np.hypot(*self.gravity))
+            gaps[(2.0 + 2.0 * math.sqrt(2.0)) * math.sqrt(delta / g)] = "under gravity"
         speed_squared = 2.0 * self.kinetic_energy() / float(self.mass.sum())
-        if not speed_squared > TINY_SPEED_SQUARED:
+        if self.conserves_kinetic_energy and speed_squared > TINY_SPEED_SQUARED:
+            gaps[2.0 * delta / math.sqrt(speed_squared)] = "the kinetic energy never changes"
+        if not gaps:
             return math.inf, ""
-        gap = 2.0 * float(np.max(self.disks.delta)) / math.sqrt(speed_squared)
+        gap = min(gaps)
         latest = self.time + (MAX_COUNT - self.events) * gap
-        reason = (f"this engine's kinetic energy never changes, so some event (a contact or a "
-                  f"shell exit) comes at least every {gap:.3g} time units, and the 2^62 "
-                  f"events a run may count reach t = {latest:.3g} at most")
+        reason = (f"{gaps[gap]}, so some event (a contact or a shell exit) comes at least "
+                  f"every {gap:.3g} time units, and the 2^62 events a run may count reach "
+                  f"t = {latest:.3g} at most")
         return latest, reason
 
     def _check_piston(self):

@@ -29,6 +29,7 @@ import os
 import signal
 import sys
 import warnings
+from concurrent.futures import BrokenExecutor
 from pathlib import Path
 
 import hydra
@@ -42,6 +43,7 @@ from sim.pipeline.cli_exits import (
     EXIT_BREAKDOWN,
     EXIT_RUN_FILE,
     fail,
+    first_line,
     quiet_hdf5_teardown,
     quiet_hdf5_traceback,
     remove_made_folders,
@@ -65,6 +67,7 @@ from sim.pipeline.overrides import (
 )
 from sim.pipeline.preflight import (
     check_command_line,
+    check_job_folders,
     check_resources,
     check_sweep_folder,
     joblib_workers,
@@ -95,7 +98,11 @@ def hydra_main(cfg):
             asked = sweep_stop.requested(Interruption.sweep_dir)
             if asked is not None:  # the sweep was stopped before this job began
                 return {"stopped": Interruption.REASONS[asked]}
-            return _job(cfg, sweeping, output_dir)
+            outcome = _job(cfg, sweeping, output_dir)
+        if sweep_stop.orphaned():  # no one is left to take the outcome or give more jobs
+            sys.stdout.flush()
+            os._exit(128 + signal.SIGTERM)
+        return outcome
     return _job(cfg, sweeping, output_dir)
 
 
@@ -176,6 +183,8 @@ def main():
     try:
         configs = check_command_line(args)
         if not prints_only(args):  # --cfg, --info, --hydra-help: no run, no folder
+            if sweeping:
+                check_job_folders(args)
             args = run_folder(args)
             check_resources(args, configs)
         if sweeping and value_of(args, "hydra.sweep.dir") is not None:
@@ -185,11 +194,22 @@ def main():
             args = joblib_workers(args, len(configs))
             sweep_dir = value_of(args, "hydra.sweep.dir")
             sweep_stop.clear(sweep_dir)  # left by a sweep killed there before
+            sweep_stop.use_sweep_workers()
+            os.environ["HYDRA_FULL_ERROR"] = "1"  # the launcher's errors come here
             guard = sweep_stop.guarded(sweep_dir, stopped_by, stop_at_once)
         sys.argv[1:] = flags_last(args)
         try:
-            with guard:
-                hydra_main()
+            try:
+                with guard:
+                    hydra_main()
+            except BrokenExecutor as error:  # a worker was killed (kill -9, the OOM killer)
+                if sweep_stop.requested(sweep_dir) is None:  # not while the sweep stopped
+                    remove_made_folders()
+                    how = next((line.strip() for line in str(error).splitlines()
+                                if "exit codes" in line), first_line(error))
+                    leave(f"sim: sweep stopped: a worker process ended ({how}); the same "
+                          f"command with hydra.sweep.dir={sweep_dir} continues its jobs",
+                          EXIT_RUN_FILE)
             if sweeping:  # the sweep is over: a late signal must not break the report
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)

@@ -75,7 +75,12 @@ def _seed(call, seed):
 
 
 class PlacementError(ValueError):
-    """Random placement could not reach the requested packing."""
+    """Disks that cannot be placed as asked: the message names the argument of the call
+    (``call(name=…) is not allowed: reason``); ``reason`` alone says why."""
+
+    def __init__(self, call, name, value, reason):
+        super().__init__(str(refused(call, name, value, reason)))
+        self.reason = reason
 
 
 @njit(cache=True)
@@ -188,11 +193,11 @@ def _layout(call, radius, box, region, periodic):
     widest = 2.0 * float(np.max(radius))
     for axis in range(2):
         if widest >= hi[axis] - lo[axis]:
-            raise PlacementError(str(refused(
+            raise PlacementError(
                 call, "radius", radius,
                 f"disks narrower than the region: a diameter {widest:g} does not fit in its "
                 f"side {hi[axis] - lo[axis]:g} along {'xy'[axis]} (the box's unless region "
-                f"is given)")))
+                f"is given)")
     return box, lo, hi, wraps
 
 
@@ -217,10 +222,11 @@ def random_sequential(radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
         reached = float(np.pi * np.sum(radius[order][:failed] ** 2) / area)
         wanted = float(np.pi * np.sum(radius**2) / area)
         raise PlacementError(
-            f"random placement stopped at packing fraction {reached:.3f} of the requested "
-            f"{wanted:.3f} ({failed} of {radius.size} disks placed): random sequential "
-            f"addition jams near φ ≈ {RSA_JAMMING}; use the hexagonal lattice "
-            f"(disks.placement=lattice) for dense packings")
+            call, "radius", radius,
+            f"disks that random placement fits in the region: it stopped at packing fraction "
+            f"{reached:.3f} of the requested {wanted:.3f} ({failed} of {radius.size} disks "
+            f"placed), and random sequential addition jams near φ ≈ {RSA_JAMMING}; use the "
+            f"hexagonal lattice (disks.placement=lattice) for dense packings")
     position = np.empty_like(placed)
     position[order] = placed
     return position
@@ -262,10 +268,11 @@ def hexagonal_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, F
         nearest = a = h = 4.0 * r_max
     if nearest < 2.0 * r_max * (1.0 - 1e-12):
         phi = n * np.pi * r_max**2 / float(np.prod(hi - lo))
-        raise PlacementError(f"{n} disks of radius {r_max} do not fit on a hexagonal lattice "
-                             f"in the region (φ = {phi:.3f}; a lattice of {columns} × {rows} "
-                             f"sites is the best fit; the ideal limit π/(2√3) ≈ 0.9069 needs a "
-                             f"box whose sides match the lattice)")
+        raise PlacementError(
+            call, "radius", radius,
+            f"disks that fit on a hexagonal lattice in the region: {n} of radius {r_max} do "
+            f"not (φ = {phi:.3f}; a lattice of {columns} × {rows} sites is the best fit; the "
+            f"ideal limit π/(2√3) ≈ 0.9069 needs a box whose sides match the lattice)")
     sites = np.arange(columns * rows)
     row, col = sites // columns, sites % columns
     x = a * (col + 0.5 * (row % 2))
@@ -333,11 +340,12 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
                                           periodic=wraps))
         reason = engine.run(collisions=collisions)
     except ValueError as error:
-        raise PlacementError(f"the lattice could not be melted: {error}") from error
+        raise PlacementError(call, "radius", radius, f"disks whose lattice an elastic run "
+                             f"can melt: {error}") from error
     if reason != "collisions":
-        raise PlacementError(f"the lattice could not be melted: its elastic run stopped after "
-                             f"{engine.collisions} of {collisions} collisions ({reason}); "
-                             f"use disks.placement=lattice")
+        raise PlacementError(call, "radius", radius, f"disks whose lattice an elastic run can "
+                             f"melt: it stopped after {engine.collisions} of {collisions} "
+                             f"collisions ({reason}); use disks.placement=lattice")
     return engine.positions() + lo
 
 

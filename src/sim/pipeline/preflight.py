@@ -52,11 +52,15 @@ def _type_error(error):
 
 def _explain_key(combination):
     """Why a key of the command line does not exist: the keys allowed beside a misspelt one
-    (disks.nn -> n, radius, …), or the scenario a section belongs to."""
+    (disks.nn -> n, radius, …), or the scenario a section belongs to; or cannot be deleted
+    (~key)."""
     scenario = [c.partition("=")[2] for c in combination if c.startswith("scenario=")]
     cfg = compose_overrides([f"scenario={s}" for s in scenario])
     for item in combination:
         key = item.partition("=")[0].lstrip("+~")
+        if item.startswith("~") and not key.startswith(("scenario", "hydra")):
+            return (f"~{key} is not allowed: a key of the config can be set but not deleted "
+                    f"(every key has a value; null where it is off): {key}=…")
         parent = key.rpartition(".")[0]
         if not parent or key.startswith("scenario"):
             continue
@@ -187,6 +191,30 @@ def joblib_workers(args, jobs):
     n_jobs = int(launcher.n_jobs) if launcher.get("n_jobs") is not None else -1
     return with_value(args, "hydra.launcher.n_jobs",
                       sweep_stop.worker_count(n_jobs, jobs, os.cpu_count() or 1))
+
+
+def check_job_folders(args):
+    """A sweep whose job folders (``hydra.sweep.subdir``, resolved for each job as the
+    launcher will) are not all different: exit 2 before any job starts, since jobs that
+    share a folder write one run file and all but one run are lost."""
+    subdir = hydra_settings(args).hydra.sweep._get_node("subdir")._value()
+    if subdir == "${hydra.job.num}":
+        return
+    jobs = {}
+    for number, combination in enumerate(combinations(args)):
+        cfg = compose_overrides(combination, hydra_config=True)
+        cfg.hydra.job.num = number
+        cfg.hydra.job.id = f"job_{number}"  # unique, as every launcher's
+        try:
+            folder = os.path.normpath(str(cfg.hydra.sweep.subdir))
+        except Exception:  # a resolver only a running job has: each job checks its folder
+            return
+        if folder in jobs:
+            fail(ConfigError("hydra.sweep.subdir", subdir,
+                             f"a folder name that differs between jobs, such as "
+                             f"${{hydra.job.num}} (jobs {jobs[folder]} and {number} would "
+                             f"both write {folder})"))
+        jobs[folder] = number
 
 
 def check_sweep_folder(args, configs):

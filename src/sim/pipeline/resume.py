@@ -278,7 +278,8 @@ def resume_locked(path, stored, reason, overrides, started):
     if len(written):  # flushed by a run killed between two checkpoints
         warnings.warn(f"{path}: resuming from its checkpoint at t = {last_time:.6g} (snapshot "
                       f"{snapshots - 1}); the {len(written)} snapshots written after it, to "
-                      f"t = {written[-1]:.6g}, are dropped and computed again from there",
+                      f"t = {written[-1]:.6g}, are dropped; the run goes on from the checkpoint "
+                      f"to its stop conditions",
                       RuntimeWarning, stacklevel=2)
     writer = open_writer(path, engine, cfg, mode="r+", observers=observers)
 

@@ -153,7 +153,7 @@ def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):
                 else (region[0][1] - region[0][0]) * (region[1][1] - region[1][0]))
         phi = n * np.pi * radius**2 / area
         raise ConfigError(key, round(phi, 4) if key.endswith("fraction") else n,
-                          str(error)) from error
+                          error.reason) from error
 
 
 def _velocities(cfg, mass):

@@ -7,15 +7,14 @@ of disks that never meet, on the energy contacts dissipate where none can, or on
 energy that never changes would never hold;
 when every condition of a scene is of that kind, :func:`check_reachable` refuses the scene
 before any work. (A scene in which nothing moves at all ends by itself: the engine then has
-no event left, stop reason ``no_events``.) So does it refuse a ``stop.time`` that a gas
-whose energy never changes reaches only after more collisions than the engine counts
-(:data:`sim.engine.inputs.MAX_COUNT`), at its collision rate (:func:`collision_rate`).
+no event left, stop reason ``no_events``.) So does it refuse a ``stop.time`` that the scene
+reaches only after more events than the engine counts (:data:`sim.engine.inputs.MAX_COUNT`),
+where that is bounded: a kinetic energy that never changes, or gravity
+(:meth:`sim.engine.Engine.latest_time`).
 """
 
 import numpy as np
 
-from sim.analysis.theory import enskog_collision_frequency, henderson_z
-from sim.engine.inputs import MAX_COUNT
 from sim.pipeline.config import ConfigError
 
 #: Above this many disks the pairwise test of :func:`_disks_never_touch` is skipped (it is
@@ -87,49 +86,27 @@ def _disks_never_touch(engine):
     return bool(np.all(never))
 
 
-def _conserves_kinetic_energy(engine):
-    """No contact loses energy, no wall gives or takes any, no field changes it."""
-    return (engine.restitution is None and engine.wall_restitution is None
-            and engine.gravity is None and engine.wall_motion is None
-            and engine.wall_temperature is None)
-
-
 def _dissipates(engine, never_touch):
-    """Whether any contact can lose energy: inelastic disks that can meet, or inelastic walls
-    in a box that has walls (the engine's energy fraction counts what contacts dissipate)."""
-    return ((engine.restitution is not None and not never_touch)
-            or (engine.wall_restitution is not None and not np.all(engine.periodic)))
-
-
-def collision_rate(engine):
-    """Disk–disk collisions per unit time of the disks of ``engine``, Enskog's N ω/2
-    (:func:`sim.analysis.theory.enskog_collision_frequency`) at their packing fraction (χ =
-    (Z − 1)/(2φ), Henderson's Z) and kinetic temperature T = E/N, every disk taken at the
-    mean diameter and mass: an estimate, to tens of percent for a gas near equilibrium."""
-    area = float(np.prod(engine.box))
-    phi = float(np.sum(np.pi * engine.radius**2)) / area
-    chi = (henderson_z(phi) - 1.0) / (2.0 * phi) if phi > 0.0 else 1.0
-    temperature = engine.kinetic_energy() / engine.n
-    omega = enskog_collision_frequency(engine.n / area, 2.0 * float(np.mean(engine.radius)),
-                                       chi, temperature, float(np.mean(engine.mass)))
-    return 0.5 * engine.n * omega
+    """Whether any contact can lose energy: of two disks that can meet, or with a wall (the
+    engine's energy fraction counts what contacts dissipate)."""
+    return (engine.disk_contacts_dissipate and not never_touch) \
+        or engine.wall_contacts_dissipate
 
 
 def check_reachable(cfg, engine):
     """Refuse (:class:`ConfigError` on ``stop``, or on ``stop.time``) a scene none of whose
     stop conditions can ever hold for the initial state of ``engine``, or that reaches its
-    ``stop.time`` only after more collisions than the engine counts; see the module
+    ``stop.time`` only after more events than the engine counts; see the module
     docstring."""
     s = cfg.stop
-    if s.time is not None and s.wall_seconds is None and s.collisions is None \
-            and s.contacts is None and _conserves_kinetic_energy(engine) and engine.n > 1:
-        expected = collision_rate(engine) * (float(s.time) - engine.time)
-        if expected > MAX_COUNT:
-            longest = engine.time + MAX_COUNT / collision_rate(engine)
-            raise ConfigError("stop.time", s.time, f"a time these disks reach in at most "
-                              f"2^62 collisions, the engine's count: at their collision rate "
-                              f"that is t ≤ {longest:.3g} (this one takes some "
-                              f"{expected:.1g}); or add stop.collisions or stop.wall_seconds")
+    others = [s.collisions, s.contacts, s.wall_seconds]
+    if not engine.conserves_kinetic_energy:  # an energy condition may end the run first
+        others += [s.energy_fraction, s.at_rest]
+    if s.time is not None and all(x is None for x in others):
+        latest, reason = engine.latest_time()
+        if float(s.time) > latest:
+            raise ConfigError("stop.time", s.time, f"a time the run can reach: {reason}; or "
+                              f"add stop.collisions or stop.wall_seconds")
     if s.time is not None or s.wall_seconds is not None:
         return
     if np.all(engine.velocities() == 0.0) and engine.gravity is None \
@@ -146,7 +123,7 @@ def check_reachable(cfg, engine):
             and not _dissipates(engine, never_touch):
         why["stop.energy_fraction"] = "no contact dissipates energy (elastic disks and walls, " \
                                       "or inelastic disks that never meet)"
-    if s.at_rest is not None and _conserves_kinetic_energy(engine) and engine.n_species == 1:
+    if s.at_rest is not None and engine.conserves_kinetic_energy and engine.n_species == 1:
         why["stop.at_rest"] = "the kinetic energy never changes"
     given = [key for key in ("collisions", "contacts", "energy_fraction", "at_rest")
              if s[key] is not None]

@@ -13,16 +13,20 @@ clears the stop file (:func:`clear`), as does the next sweep into the folder. A 
 signal to the sweep's process ends it and its workers at once, as SIGKILL would.
 
 The sweep's process takes both signals with a handler of its own (:func:`guarded`), a job
-with another while it runs (:func:`job`). A worker that has no job (starting up, or between
-two jobs) keeps Python's handlers, and a signal to it alone ends it and breaks joblib's pool;
-so the launcher starts no more workers than jobs (:func:`worker_count`).
+with another while it runs (:func:`job`). A joblib worker ignores them outside its jobs, from
+its start (:func:`worker_started`): a worker that a signal ended while it waited for a job
+would break joblib's pool, whose other workers are then killed mid-run. A worker whose sweep
+process has ended (SIGKILL) stops its job as at SIGTERM (:func:`requested`) rather than
+compute on for no one. The launcher starts no more workers than jobs (:func:`worker_count`).
 """
 
 import contextlib
+import functools
 import os
 import signal
 import threading
 from contextlib import contextmanager
+from multiprocessing import resource_tracker
 from pathlib import Path
 
 #: the stop file, in the sweep folder
@@ -45,7 +49,10 @@ def request(sweep_dir, signum):
 
 
 def requested(sweep_dir):
-    """The signal the sweep in ``sweep_dir`` was asked to stop for, or None."""
+    """The signal the sweep in ``sweep_dir`` was asked to stop for, or None; in a worker
+    whose sweep process has ended, SIGTERM."""
+    if orphaned():
+        return signal.SIGTERM
     try:
         name = stop_file(sweep_dir).read_text().strip()
     except FileNotFoundError:
@@ -60,15 +67,50 @@ def clear(sweep_dir):
 #: the signals that stop a sweep
 SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
+#: in a joblib worker of a sweep, the pid of the sweep's process (:func:`worker_started`)
+SWEEP_PROCESS = None
+
+
+def worker_started(sweep_process):
+    """The start of a joblib worker of the sweep whose process is ``sweep_process`` (loky's
+    initializer, :func:`use_sweep_workers`): SIGINT and SIGTERM are ignored outside its jobs
+    (:func:`job` takes them in a job)."""
+    global SWEEP_PROCESS
+    SWEEP_PROCESS = sweep_process
+    for number in SIGNALS:
+        signal.signal(number, signal.SIG_IGN)  # also drops one pending since the start
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)  # blocked from the start (guarded)
+
+
+def orphaned():
+    """Whether this process is a joblib worker whose sweep process has ended (SIGKILL)."""
+    return SWEEP_PROCESS is not None and os.getppid() != SWEEP_PROCESS
+
+
+def use_sweep_workers():
+    """joblib's loky backend, which Hydra's joblib launcher asks for by name, made in this
+    process with workers that begin with :func:`worker_started`."""
+    from joblib import register_parallel_backend
+    from joblib._parallel_backends import LokyBackend
+
+    register_parallel_backend("loky", functools.partial(
+        LokyBackend, initializer=worker_started, initargs=(os.getpid(),)))
+
 
 @contextmanager
 def guarded(sweep_dir, taken, at_second_signal):
     """The sweep's process inside the block, which runs its jobs: the first SIGINT or SIGTERM
     is ``taken(signal)`` and :func:`request`; a second ends the workers at once (SIGKILL)
-    and is ``at_second_signal(signal)``. The handlers are as they were after the block."""
+    and is ``at_second_signal(signal)``.
+
+    Inside the block the process's threads block both signals, and a thread of its own
+    takes them (``sigtimedwait``): the workers, started from these threads, inherit the
+    mask and so cannot die of a signal before :func:`worker_started` ignores it (the guard
+    Python's own resource tracker uses, bpo-33613). The handlers and the mask are as they
+    were after the block."""
     count = []
 
-    def take(signum, frame):
+    def take(signum, frame=None):
         if count:  # at once, as for a single run: the workers too
             for pid in _children():
                 with contextlib.suppress(ProcessLookupError):
@@ -78,12 +120,25 @@ def guarded(sweep_dir, taken, at_second_signal):
         taken(signal.Signals(signum))
         request(sweep_dir, signum)
 
+    def wait(over):
+        while not over.is_set():
+            if (received := signal.sigtimedwait(SIGNALS, 0.1)) is not None:
+                take(received.si_signo)
+
+    resource_tracker.ensure_running()  # started later, it would unblock this thread's mask
     previous = {number: signal.signal(number, take) for number in SIGNALS}
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    over = threading.Event()
+    waiting = threading.Thread(target=wait, args=(over,), name="sweep signals", daemon=True)
+    waiting.start()
     try:
         yield
     finally:
+        over.set()
+        waiting.join()
         for number, handling in previous.items():
             signal.signal(number, handling)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def _children():
