@@ -32,6 +32,7 @@ import yaml
 from sim.pipeline import runner
 from sim.pipeline.config import ConfigError
 from sim.pipeline.run_cache import compose_config
+from sim.pipeline.sweep_stop import descendants
 from sim.storage.inspect import summary
 
 PY = sys.executable
@@ -382,6 +383,18 @@ def test_flags_that_only_print_make_no_run_folder(flags, entry, tmp_path):
     assert tree(tmp_path) == {}
 
 
+def test_cfg_job_of_a_resume_shows_the_config_it_runs(small_run, entry, tmp_path):
+    """``resume=FILE --cfg job`` prints the run file's config with the overrides, not the
+    default config Hydra would compose, and makes nothing."""
+    path = copy_run(small_run, tmp_path)
+    before = tree(tmp_path)
+    result = entry(f"resume={path}", "stop.collisions=5000", "--cfg", "job")
+    assert result.code == 0, result.err
+    shown = yaml.safe_load(result.out)
+    assert shown["disks"]["n"] == 200 and shown["stop"]["collisions"] == 5000
+    assert tree(tmp_path) == before
+
+
 def test_a_misspelt_key_is_quoted_with_the_value_given(entry, tmp_path):
     """``disks.nn=3``: the message quotes what was typed (3), not ``None``."""
     result = entry("disks.nn=3")
@@ -716,7 +729,7 @@ def test_a_stored_value_of_the_wrong_type_is_one_plain_line(entry, small_run, tm
         config["disks"]["n"] = "two hundred"
         f["parameters"].attrs["config"] = yaml.safe_dump(config)
     result = entry(f"resume={good}", "stop.collisions=4000")
-    check(result, 2, ["resume", "two hundred"])
+    check(result, 2, ["resume", "two hundred", "disks.n"])
     assert "object_type" not in result.err and "reference_type" not in result.err
 
 
@@ -1162,23 +1175,6 @@ def still_running(pids):
         if state != "Z":
             running.append(pid)
     return running
-
-
-def descendants(pid):
-    """The pids of every process under ``pid`` (from /proc)."""
-    parents = {}
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rpartition(")")[2].split()
-        except OSError:  # ended meanwhile
-            continue
-        parents.setdefault(int(fields[1]), []).append(int(stat.parent.name))
-    found, todo = [], [pid]
-    while todo:
-        children = parents.get(todo.pop(), [])
-        found += children
-        todo += children
-    return found
 
 
 @pytest.mark.parametrize("to, how, seeds", [("the workers", signal.SIGTERM, "0,1"),

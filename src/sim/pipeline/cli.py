@@ -35,6 +35,7 @@ from pathlib import Path
 import hydra
 from hydra.core.hydra_config import HydraConfig
 from hydra.types import RunMode
+from omegaconf import OmegaConf
 
 from sim.__main__ import leave
 from sim.engine.errors import PhysicsBreakdown
@@ -61,6 +62,7 @@ from sim.pipeline.overrides import (
     CONF_DIR,
     SWEEP_FLAGS,
     flags_last,
+    hydra_arguments,
     prints_only,
     value_of,
     whole_numbers,
@@ -182,6 +184,9 @@ def main():
         os.environ.setdefault("PYTHONWARNINGS", "ignore:resource_tracker:UserWarning")
     try:
         configs = check_command_line(args)
+        if value_of(args, "resume") is not None and hydra_arguments(args).cfg == "job":
+            print(OmegaConf.to_yaml(configs[0]), end="")  # what it runs, not Hydra's defaults
+            return
         if not prints_only(args):  # --cfg, --info, --hydra-help: no run, no folder
             if sweeping:
                 check_job_folders(args)

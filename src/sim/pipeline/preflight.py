@@ -76,7 +76,7 @@ def _explain_key(combination):
 
 def check_command_line(args):
     """Compose and validate every job the command line asks for; exit 2 on the first bad
-    one. Returns the composed configs, one per job."""
+    one. Returns the composed configs, one per job (a resume's: the config it runs)."""
     sweeping = any(a in SWEEP_FLAGS for a in args)
     configs = []
     for combination in combinations(args):
@@ -88,7 +88,7 @@ def check_command_line(args):
                 if sweeping:
                     raise ConfigError("resume", cfg.resume, "a single run, not a sweep (-m)")
                 task = task_overrides(combination)
-                resumable(cfg.resume, [c for c in task if not c.startswith("resume=")])
+                cfg = resumable(cfg.resume, [c for c in task if not c.startswith("resume=")])
             configs.append(cfg)
         except ConfigError as error:
             fail(str(error))

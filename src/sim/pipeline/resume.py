@@ -106,7 +106,8 @@ def stored_config(path, key="resume"):
     except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
         # the first line: OmegaConf's errors go on with the context of the failing key
         reason = (str(error).strip().splitlines() or [""])[0]
-        raise ConfigError(key, str(path), f"a run file with its config intact: "
+        where = f"its stored {error.full_key}: " if getattr(error, "full_key", None) else ""
+        raise ConfigError(key, str(path), f"a run file with its config intact: {where}"
                           f"{type(error).__name__}: {reason}") from error
     try:
         validate(stored)

@@ -112,7 +112,7 @@ def guarded(sweep_dir, taken, at_second_signal):
 
     def take(signum, frame=None):
         if count:  # at once, as for a single run: the workers too
-            for pid in _children():
+            for pid in descendants(os.getpid()):
                 with contextlib.suppress(ProcessLookupError):
                     os.kill(pid, signal.SIGKILL)
             at_second_signal(signal.Signals(signum))
@@ -141,17 +141,21 @@ def guarded(sweep_dir, taken, at_second_signal):
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
-def _children():
-    """The pids of this process's children (from /proc)."""
-    mine = str(os.getpid())
-    pids = []
+def descendants(pid):
+    """The pids of every process under ``pid`` (from /proc)."""
+    children = {}
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
-            if stat.read_text().rpartition(")")[2].split()[1] == mine:
-                pids.append(int(stat.parent.name))
+            parent = int(stat.read_text().rpartition(")")[2].split()[1])
         except (OSError, IndexError):  # ended meanwhile
             continue
-    return pids
+        children.setdefault(parent, []).append(int(stat.parent.name))
+    found, todo = [], [pid]
+    while todo:
+        under = children.get(todo.pop(), [])
+        found += under
+        todo += under
+    return found
 
 
 @contextmanager
