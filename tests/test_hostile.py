@@ -282,6 +282,7 @@ BAD_INPUT = {
     "misspelt-disks.nn": ("disks.nn=3", "disks.nn"),
     "sweep-item-abc": ("stop.collisions=2e6,abc -m", "abc"),
     "sweep-item-nan": ("restitution.disk=0.5,nan -m", "restitution.disk"),
+    "unbalanced-bracket": ("seed=1)", "seed=1)"),
     "delete-a-key": ("~seed", "~seed"),
     "delete-a-stop-key": ("~stop.collisions", "stop.collisions=…"),
     "sweep-jobs-in-one-folder": ("seed=0,1 hydra.sweep.subdir=same -m", "hydra.sweep.subdir"),

@@ -118,14 +118,16 @@ def _unreadable(overrides, error):
             shown = value if len(value) <= 40 else f"{value[:20]}… ({len(value)} characters)"
             reason = str(failure).strip().splitlines()[0] if str(failure).strip() else ""
             if "Exceeds the limit" in reason:  # Python's cap on the digits of an int
-                reason = f"a number, not one of {len(value)} digits"
+                return f"{key}={shown} is not allowed: a number, not one of {len(value)} digits"
             if not equals:  # a word cut from the value before it by a space
                 at = overrides.index(override)
                 before = f" after {overrides[at - 1]}" if at else ""
                 return (f"{override!r}{before} is not allowed: an override is KEY=VALUE; a "
                         f"value with spaces is quoted whole, 'KEY=a value' (the shell splits "
                         f"it at the space)")
-            return f"{key}={shown} is not allowed: {reason or first_line(failure)}"
+            return (f"{key}={shown} is not allowed: a value Hydra's override grammar reads "
+                    f"({reason or first_line(failure)}); quote one with brackets, commas or "
+                    f"spaces as text, '{key}=\"…\"', or write a list [a,b] or a sweep a,b")
     return first_line(error)
 
 
