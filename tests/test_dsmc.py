@@ -4,6 +4,7 @@ Enskog's collision frequency, Garzó & Dufty's mixture temperatures, Haff's law,
 state of rough disks; and its reproducibility. N = 2·10⁴ disks, runs of 7–30 collisions per
 disk."""
 
+import json
 import math
 
 import numpy as np
@@ -201,3 +202,17 @@ def test_the_cooling_state_agrees_with_an_earlier_dsmc():
     roughness is over: sim.checks.dsmc.cooling_state.)"""
     state = dsmc.cooling_state(UNIT, dsmc.RoughDisks(0.9, 0.5), N, seeds=range(4))
     assert abs(state.ratio - 0.7705) <= 4.0 * state.ratio_error + 0.002 * 0.7705
+
+
+def test_the_command_writes_a_cooling_state_per_pair_and_refuses_bad_pairs(tmp_path, capsys):
+    out = tmp_path / "dsmc.json"
+    dsmc.main(["--states", "0.9:0.5", "1:0", "--particles", "400", "--seeds", "1",
+               "--collisions", "6", "--burn-in", "1", "--out", str(out)])
+    results = json.loads(out.read_text())["results"]
+    assert [(r["restitution"], r["roughness"]) for r in results] == [(0.9, 0.5), (1.0, 0.0)]
+    assert all(r["ratio_error"] > 0.0 and r["collisions_per_particle"] >= 6 for r in results)
+    for bad in ("0.9", "0:0.5", "0.9:2", "a:b"):
+        with pytest.raises(SystemExit):
+            dsmc.main(["--states", bad, "--out", str(tmp_path / "no.json")])
+        assert "ξ:β" in capsys.readouterr().err
+    assert not (tmp_path / "no.json").exists()

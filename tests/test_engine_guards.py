@@ -164,6 +164,14 @@ def test_the_engine_refuses_what_is_not_real_numbers_naming_the_argument():
             species=[0.5, 1])
     refused(r"^Engine\(restitution=…\) is not allowed: one number or a symmetric 2 × 2 matrix",
             position, velocity, 0.01, species=[0, 1], restitution=np.full((3, 3), 0.9))
+    refused(r"^Engine\(radius=…\) is not allowed: one number, or one per disk \(2 numbers\)",
+            position, velocity, [0.01, 0.01, 0.01])
+    refused(r"^Engine\(mass=…\) is not allowed: one number, or one per disk",
+            position, velocity, 0.01, [[1.0, 1.0]])
+    refused(r"^Engine\(species=…\) is not allowed: whole numbers from 0 to 1023", position,
+            velocity, 0.01, species=[0, 10**6])
+    refused(r"^Engine\(boundary=\(1\.0, 1\.0\)\) is not allowed: a sim\.engine\.Boundary",
+            position, velocity, 0.01, boundary=(1.0, 1.0))
 
 
 #: Engine keywords that size its shells and lists, and boundaries, that no engine can take:
@@ -466,7 +474,7 @@ UNREACHABLE_RUNS = {
                                     "reach: the kinetic energy never changes"),
     "time-1e20": ({"time": 1e20}, "run(time=1e+20)"),
     "both": ({"time": 1e300, "energy_fraction": 0.5},
-             "run(time=1e+300, energy_fraction=0.5) is not allowed: neither can hold"),
+             "run(time=1e+300, energy_fraction=0.5) is not allowed: none can hold"),
 }
 
 
@@ -509,6 +517,21 @@ def test_an_elastic_gas_has_an_event_within_the_bound_of_its_latest_time():
         before = engine.time
 
 
+def test_run_refuses_collisions_of_disks_that_never_touch():
+    """One disk in a box, or two that keep their axis apart, never collide: run(collisions=…)
+    alone is refused (it ran for ever), as the command line refuses stop.collisions."""
+    lone = Engine([[0.5, 0.5]], [[1.0, 0.0]], 0.01)
+    with pytest.raises(ValueError, match=r"^run\(collisions=10\) is not allowed: a count these "
+                                         r"disks reach: one disk has no other"):
+        lone.run(collisions=10)
+    assert lone.run(collisions=10, events=100) == "events"
+    apart = Engine([[0.2, 0.3], [0.2, 0.7]], [[0.0, 1.0], [0.0, 1.0]], 0.01,
+                   boundary=Boundary(periodic=True))
+    with pytest.raises(ValueError, match=r"^run\(contacts=5, collisions=5\) is not allowed: "
+                                         r"none can hold"):
+        apart.run(collisions=5, contacts=5)
+
+
 def test_a_bed_under_gravity_has_an_event_within_the_bound_of_its_latest_time():
     """The premise of the refusal of a time beyond reach under gravity, whatever the energy
     does: disks settling inelastically on a floor never wait longer than (2 + 2√2) √(δ/g)
@@ -526,6 +549,10 @@ def test_a_bed_under_gravity_has_an_event_within_the_bound_of_its_latest_time():
     with pytest.raises(ValueError, match=r"^run\(time=1e\+300\) is not allowed: a time this "
                                          r"engine can reach: under gravity"):
         engine.run(time=1e300)
+    driven = gas(50, 0.05, seed=8, restitution=0.9, walls={"bottom": {"temperature": 1.0}})
+    with pytest.raises(ValueError, match=r"^run\(time=1e\+50\) is not allowed: a time this "
+                                         r"engine can reach: its thermal walls"):
+        driven.run(time=1e50)
 
 
 def test_run_takes_whole_floats_and_numpy_numbers():

@@ -283,6 +283,10 @@ BAD_INPUT = {
     "sweep-item-abc": ("stop.collisions=2e6,abc -m", "abc"),
     "sweep-item-nan": ("restitution.disk=0.5,nan -m", "restitution.disk"),
     "unbalanced-bracket": ("seed=1)", "seed=1)"),
+    "neither-speed-nor-temperature": ("disks.speed=null disks.temperature=null", "disks.speed"),
+    "sweep-job-folder-outside-the-sweep": ("seed=0,1 hydra.sweep.subdir=../out${hydra.job.num} -m",
+                                           "hydra.sweep.subdir"),
+    "no-workers": ("seed=0,1 hydra.launcher.n_jobs=0 -m", "hydra.launcher.n_jobs"),
     "delete-a-key": ("~seed", "~seed"),
     "delete-a-stop-key": ("~stop.collisions", "stop.collisions=…"),
     "sweep-jobs-in-one-folder": ("seed=0,1 hydra.sweep.subdir=same -m", "hydra.sweep.subdir"),
@@ -460,6 +464,10 @@ NEVER = {
                                     "stop.time"),
     "time-beyond-2^62-collisions-sparse": ("disks.n=100 stop.collisions=null stop.time=1e50 "
                                            "output.every_time=1e49", "stop.time"),
+    "time-beyond-2^62-events-of-a-driven-gas": ("scenario=driven disks.n=200 stop.collisions=null "
+                                                "stop.time=1e50", "stop.time"),
+    "settling-for-ever": ("scenario=crater_gravity bed.n=300 bed.settle_time=1e6",
+                          "bed.settle_time"),
     "time-beyond-2^62-events-under-gravity": ("disks.n=100 gravity=[0,-1] restitution.disk=0.9 "
                                               "restitution.wall=0.9 tc.time=1e-4 "
                                               "stop.collisions=null stop.time=1e50", "stop.time"),

@@ -379,17 +379,49 @@ def cooling_state(gas, rule, n_particles, seeds, burn_in=20.0, collisions_per_pa
     return CoolingState(*block_means(ratio_blocks), *block_means(rate_blocks), total)
 
 
+#: (ξ, β) of the cooling states the validation table compares with the engine
+#: (:func:`sim.checks.rough.rough_cooling`)
+STATES = ((0.9, 0.5), (0.9, 0.0), (0.8, -0.5), (0.7, 0.5))
+
+#: the cooling states as ``make dsmc`` writes them, in the repository
+RESULTS = Path(__file__).resolve().parents[3] / "docs" / "results" / "dsmc.json"
+
+
+def stored_cooling_state(restitution, roughness, path=RESULTS):
+    """The cooling state of (ξ, β) that ``make dsmc`` wrote to ``path``: a dict of the fields
+    of :class:`CoolingState` and the theory's ratio and rate. A pair it does not hold is a
+    KeyError naming it."""
+    for result in json.loads(Path(path).read_text())["results"]:
+        if (result["restitution"], result["roughness"]) == (restitution, roughness):
+            return result
+    raise KeyError(f"{path} holds no cooling state for ξ = {restitution}, β = {roughness}: "
+                   f"make dsmc")
+
+
+def _state(text):
+    """``ξ:β`` of the command line as (ξ, β)."""
+    xi, colon, beta = text.partition(":")
+    try:
+        state = (float(xi), float(beta))
+    except ValueError:
+        state = None
+    if not colon or state is None or not (0.0 < state[0] <= 1.0 and -1.0 <= state[1] <= 1.0):
+        raise argparse.ArgumentTypeError(f"{text!r}: ξ:β with ξ in (0, 1] and β in [−1, 1]")
+    return state
+
+
 def main(argv=None):
-    """The cooling state of rough disks for each β, against the two-temperature Maxwellian
+    """The cooling state of rough disks for each (ξ, β), against the two-temperature Maxwellian
     theory (:func:`sim.analysis.theory.rough_disk_temperature_ratio`,
     :func:`sim.analysis.theory.rough_disk_cooling_rate`), written as JSON to ``--out``."""
     parser = argparse.ArgumentParser(
         prog="python -m sim.checks.dsmc",
         description="DSMC of the homogeneous cooling state of rough disks (one species, "
                     "dilute): T_rot/T_tr and ζ/ν against the Maxwellian theory.")
-    parser.add_argument("--restitution", type=float, default=0.9, help="ξ (default 0.9)")
-    parser.add_argument("--roughness", type=float, nargs="+", default=[0.5, 0.0],
-                        help="β values in [−1, 1] (default 0.5 0)")
+    parser.add_argument("--states", type=_state, nargs="+", default=STATES,
+                        metavar="ξ:β", help="restitution ξ in (0, 1] and roughness β in "
+                        "[−1, 1] of each cooling state (default: those of the validation "
+                        "table, " + " ".join(f"{xi}:{beta}" for xi, beta in STATES) + ")")
     parser.add_argument("--q", type=float, default=0.5, help="q of I = q m a² (default 0.5)")
     parser.add_argument("--particles", type=int, default=20000, help="N (default 20000)")
     parser.add_argument("--seeds", type=int, default=8, help="independent runs (default 8)")
@@ -404,18 +436,18 @@ def main(argv=None):
     args = parser.parse_args(argv)
     gas = Gas(inertia_factor=args.q)
     results = []
-    for beta in args.roughness:
+    for xi, beta in args.states:
         started = time.perf_counter()
-        state = cooling_state(gas, RoughDisks(args.restitution, beta), args.particles,
+        state = cooling_state(gas, RoughDisks(xi, beta), args.particles,
                               range(args.seeds), args.burn_in, args.collisions,
                               step_fraction=args.step_fraction)
         results.append({
-            "roughness": beta, **state._asdict(),
-            "theory_ratio": rough_disk_temperature_ratio(args.restitution, beta, args.q),
-            "theory_cooling_rate": rough_disk_cooling_rate(args.restitution, beta, args.q),
+            "restitution": xi, "roughness": beta, **state._asdict(),
+            "theory_ratio": rough_disk_temperature_ratio(xi, beta, args.q),
+            "theory_cooling_rate": rough_disk_cooling_rate(xi, beta, args.q),
             "seconds": time.perf_counter() - started})
         r = results[-1]
-        print(f"ξ = {args.restitution}, β = {beta}, q = {args.q}: T_rot/T_tr = "
+        print(f"ξ = {xi}, β = {beta}, q = {args.q}: T_rot/T_tr = "
               f"{r['ratio']:.5f} ± {r['ratio_error']:.5f} (theory {r['theory_ratio']:.5f}), "
               f"ζ/ν = {r['cooling_rate']:.5f} ± {r['cooling_rate_error']:.5f} (theory "
               f"{r['theory_cooling_rate']:.5f}), C/N = {r['collisions_per_particle']:.0f}, "

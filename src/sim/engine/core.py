@@ -25,6 +25,7 @@ from sim.engine.inputs import (
     check_disks,
     check_inside,
     check_scales,
+    per_disk,
     periodic_pair,
     real_array,
     real_number,
@@ -89,8 +90,8 @@ class Engine(Running, Observables, Checkpoints):
         if position.shape != (n, 2) or velocity.shape != (n, 2) or n == 0:
             raise ValueError(f"position and velocity must both be (n, 2) with n ≥ 1; got "
                              f"{position.shape} and {velocity.shape}")
-        radius = np.array(np.broadcast_to(real_array("Engine", "radius", radius), (n,)))
-        mass = np.array(np.broadcast_to(real_array("Engine", "mass", mass), (n,)))
+        radius = per_disk("Engine", "radius", radius, n)
+        mass = per_disk("Engine", "mass", mass, n)
         species = np.zeros(n, np.int32) if species is None else species_input(species, n)
         check_disks(position, velocity, radius, mass, species)
         box = box_size(boundary)

@@ -53,7 +53,10 @@ def check_disks(position, velocity, radius, mass, species):
 
 def box_size(boundary):
     """The box sides float64[2] of a :class:`Boundary`, each finite and > 0
-    (:func:`box_sides`)."""
+    (:func:`box_sides`); a ValueError for what is no :class:`Boundary`."""
+    if not isinstance(boundary, Boundary):
+        raise refused("Engine", "boundary", boundary,
+                      "a sim.engine.Boundary(size=(Lx, Ly), periodic=…)", show=True)
     return box_sides("Boundary", "size", boundary.size)
 
 
@@ -235,12 +238,26 @@ def _number_text(number):
     return str(number)
 
 
+#: The most species an engine holds: per-pair values (restitution) are S × S matrices.
+MAX_SPECIES = 1024
+
+
+def per_disk(call, name, value, n):
+    """``value`` as float64[n]: one number for every disk, or one per disk; a ValueError
+    naming ``name`` of ``call`` otherwise."""
+    array = real_array(call, name, value)
+    if array.ndim > 1 or array.size not in (1, n):
+        raise refused(call, name, value, f"one number, or one per disk ({n} numbers)")
+    return np.array(np.broadcast_to(array, (n,)))
+
+
 def species_input(species, n):
     """Species numbers int32[n] (one number for every disk, or one per disk); a ValueError
-    for what is not whole numbers from 0 to 2^31 − 1."""
-    numbers = np.broadcast_to(real_array("Engine", "species", species), (n,))
-    if not np.all((numbers >= 0) & (numbers < 2**31) & (numbers == np.floor(numbers))):
-        raise refused("Engine", "species", species, "whole numbers from 0 to 2^31 - 1")
+    for what is not whole numbers from 0 to :data:`MAX_SPECIES` − 1."""
+    numbers = per_disk("Engine", "species", species, n)
+    if not np.all((numbers >= 0) & (numbers < MAX_SPECIES) & (numbers == np.floor(numbers))):
+        raise refused("Engine", "species", species,
+                      f"whole numbers from 0 to {MAX_SPECIES - 1}")
     return numbers.astype(np.int32)
 
 
@@ -342,27 +359,24 @@ def check_stop(contacts, collisions, events, time, energy_fraction, wall_seconds
             whole_count("run", "chunk_events", chunk_events, low=1))
 
 
-def check_reachable(time, energy_fraction, energy_reachable, latest_time, time_reason):
-    """Refuse a run of :meth:`sim.engine.Engine.run` whose only stop conditions, ``time``
-    and ``energy_fraction`` (as given, which :func:`check_stop` accepted; None when not
-    given), can never hold, as the command line refuses such a ``stop``
-    (:func:`sim.pipeline.stop_conditions.check_reachable`): ``energy_fraction`` < 1 when
-    ``energy_reachable`` is False (no contact dissipates energy and the fraction is not met
-    already), ``time`` beyond ``latest_time`` (``time_reason`` says why)."""
-    why = {}
-    if energy_fraction is not None and float(energy_fraction) < 1.0 and not energy_reachable:
-        why["energy_fraction"] = ("a fraction this engine can reach: no contact of it "
-                                  "dissipates energy (elastic disks and walls, smooth or "
-                                  "elastic rough contacts)")
-    if time is not None and float(time) > latest_time:
-        why["time"] = f"a time this engine can reach: {time_reason}"
-    given = {name: value for name, value in (("time", time), ("energy_fraction", energy_fraction))
-             if value is not None}
-    if why and len(why) == len(given):
-        other = "; add another stop condition (collisions, contacts, events, wall_seconds, until)"
-        if len(why) == 1:
-            (name, allowed), = why.items()
-            raise refused("run", name, given[name], allowed + other)
-        shown = ", ".join(f"{name}={value!r}" for name, value in given.items())
-        raise ValueError(f"run({shown}) is not allowed: neither can hold: "
-                         + "; ".join(f"{name}: {text}" for name, text in why.items()) + other)
+#: the stop conditions of :meth:`sim.engine.Engine.run`, in the order of its signature
+STOP_NAMES = ("contacts", "collisions", "events", "time", "energy_fraction", "wall_seconds",
+              "until")
+
+
+def check_reachable(given, never):
+    """Refuse a run of :meth:`sim.engine.Engine.run` none of whose stop conditions can ever
+    hold, as the command line refuses such a ``stop``
+    (:func:`sim.pipeline.stop_conditions.check_reachable`): ``given`` maps the conditions
+    given (as given, which :func:`check_stop` accepted) to their values, ``never`` those
+    that can never hold to what is allowed instead."""
+    if not given or set(given) - set(never):
+        return
+    other = ("; add another stop condition ("
+             + ", ".join(name for name in STOP_NAMES if name not in given) + ")")
+    if len(given) == 1:
+        (name, value), = given.items()
+        raise refused("run", name, value, never[name] + other)
+    shown = ", ".join(f"{name}={value!r}" for name, value in given.items())
+    raise ValueError(f"run({shown}) is not allowed: none can hold: "
+                     + "; ".join(f"{name}: {never[name]}" for name in given) + other)

@@ -13,7 +13,7 @@ from sim.engine import codes, loop
 from sim.engine.compilation import compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
 from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
-from sim.engine.inputs import MAX_COUNT, check_reachable, check_stop
+from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 
 #: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
@@ -23,6 +23,15 @@ from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 TIMED_CHUNK_SECONDS = 0.15
 TIMED_FIRST_CHUNK = 20_000
 TIMED_MIN_CHUNK = 1_000
+
+
+#: The coldest a gas driven by thermal walls is taken to be, as a fraction of the walls'
+#: temperature, in :meth:`Running.latest_time` (an estimate with a wide margin).
+COLDEST_DRIVEN = 1e-6
+
+#: Above this many disks :meth:`Running.disks_never_touch` tests no pairs (O(N²) in memory);
+#: scenes of disks that provably never meet are small hand-made ones.
+PAIRWISE_LIMIT = 2000
 
 
 class Running:
@@ -107,11 +116,13 @@ class Running:
         piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended it.
         Chunk sizes change no result: the same inputs give the same bits.
         """
-        given = time, energy_fraction  # as written, for a refusal
+        given = dict(zip(STOP_NAMES, (contacts, collisions, events, time, energy_fraction,
+                                      wall_seconds, until), strict=True))  # as written
         (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
          chunk_events) = check_stop(contacts, collisions, events, time, energy_fraction,
                                     wall_seconds, until, chunk_events)
-        self._refuse_unreachable(contacts, collisions, events, *given, wall_seconds, until)
+        self._refuse_unreachable({name: value for name, value in given.items()
+                                  if value is not None}, collisions, contacts, energy_fraction)
         big = np.iinfo(np.int64).max
         max_contacts = big if contacts is None else contacts
         max_events = big if events is None else events
@@ -154,16 +165,63 @@ class Running:
                 if until is not None and until(self):
                     return "predicate"
 
-    def _refuse_unreachable(self, contacts, collisions, events, time, energy_fraction,
-                            wall_seconds, until):
-        """:func:`check_reachable` for the arguments of :meth:`run`, which
-        :func:`check_stop` accepted."""
-        others = (contacts, collisions, events, wall_seconds, until)
-        if all(x is None for x in others) and (time is not None or energy_fraction is not None):
-            dissipating = self.disk_contacts_dissipate or self.wall_contacts_dissipate
-            met = (energy_fraction is not None and self.dissipated_energy
-                   >= self.initial_energy * (1.0 - float(energy_fraction)))
-            check_reachable(time, energy_fraction, dissipating or met, *self.latest_time())
+    def _refuse_unreachable(self, given, collisions, contacts, energy_fraction):
+        """:func:`check_reachable` for the stop conditions ``given`` to :meth:`run` (name →
+        value as given), with the counts and fraction that :func:`check_stop` made of them."""
+        never = {}
+        moves = (np.any(self.velocities() != 0.0) or self.gravity is not None
+                 or self.wall_motion is not None)
+        touch = ({"collisions", "contacts"} & set(given)) and moves
+        never_touch = bool(touch) and self.disks_never_touch()
+        if collisions is not None and collisions > self.collisions and never_touch:
+            never["collisions"] = ("a count these disks reach: "
+                                   + ("one disk has no other to collide with" if self.n == 1
+                                      else "they never touch one another"))
+        if contacts is not None and contacts > self.contacts and never_touch \
+                and bool(np.all(self.periodic)):
+            never["contacts"] = ("a count these disks reach: a periodic box has no walls and "
+                                 "they never touch one another")
+        if energy_fraction is not None and energy_fraction < 1.0 \
+                and not (self.disk_contacts_dissipate or self.wall_contacts_dissipate) \
+                and self.dissipated_energy < self.initial_energy * (1.0 - energy_fraction):
+            never["energy_fraction"] = ("a fraction this engine can reach: no contact of it "
+                                        "dissipates energy (elastic disks and walls, smooth or "
+                                        "elastic rough contacts)")
+        if "time" in given:
+            latest, reason = self.latest_time()
+            if float(given["time"]) > latest:
+                never["time"] = f"a time this engine can reach: {reason}"
+        check_reachable(given, never)
+
+    def disks_never_touch(self):
+        """Whether no two disks can ever touch: no force acts between contacts (no gravity,
+        every wall still and not thermal), and every pair either moves with one velocity in a
+        periodic box, or keeps an axis fixed on which the two are further apart than contact
+        (a disk with v_x = 0 keeps its x until its first contact, also when it bounces off
+        the walls along y). Above :data:`PAIRWISE_LIMIT` disks only the first holds."""
+        if self.n < 2:
+            return True
+        if self.gravity is not None or self.wall_motion is not None \
+                or self.wall_temperature is not None:
+            return False
+        position, velocity = self.positions(), self.velocities()
+        one_velocity = bool(np.all(self.periodic)) and bool(np.all(velocity == velocity[0]))
+        if one_velocity:
+            return True
+        if self.n > PAIRWISE_LIMIT or np.any(np.all(velocity != 0.0, axis=1)):
+            return False  # a disk moving along no axis may meet any other: no pairs to test
+        pairs = np.triu_indices(self.n, 1)
+        sigma = self.radius[pairs[0]] + self.radius[pairs[1]]
+        never = np.zeros(sigma.size, dtype=bool)
+        if np.all(self.periodic):
+            never |= np.all(velocity[pairs[0]] == velocity[pairs[1]], axis=1)
+        for axis in range(2):
+            fixed = velocity[:, axis] == 0.0
+            gap = np.abs(position[pairs[0], axis] - position[pairs[1], axis])
+            if self.periodic[axis]:
+                gap = np.minimum(gap, self.box[axis] - gap)
+            never |= fixed[pairs[0]] & fixed[pairs[1]] & (gap >= sigma)
+        return bool(np.all(never))
 
     @property
     def disk_contacts_dissipate(self):
@@ -195,7 +253,11 @@ class Running:
         - (2 + 2√2) √(δ/g) under gravity g, whatever the energy does: on a parabola the
           displacement vt − gt²/2 along g leaves [−2δ, 2δ] by then from any speed v (the
           slowest start, v just under 2√(gδ) upward, rises almost 2δ and takes that long
-          to fall to 2δ below).
+          to fall to 2δ below);
+        - 2 δ / √(2 ε T_w/m) with thermal walls at T_w (the coldest, m the largest mass),
+          ε = :data:`COLDEST_DRIVEN`: an estimate, not a bound, with a wide margin: the walls
+          keep the gas warm, and a driven gas in its steady state is not a million times
+          colder than its walls.
 
         Returns (that time, the reason in words)."""
         delta = float(np.max(self.disks.delta))
@@ -206,6 +268,12 @@ class Running:
         speed_squared = 2.0 * self.kinetic_energy() / float(self.mass.sum())
         if self.conserves_kinetic_energy and speed_squared > TINY_SPEED_SQUARED:
             gaps[2.0 * delta / math.sqrt(speed_squared)] = "the kinetic energy never changes"
+        if self.wall_temperature is not None:
+            t_wall = float(np.nanmin(self.wall_temperature))
+            speed = math.sqrt(2.0 * COLDEST_DRIVEN * t_wall / float(self.mass.max()))
+            gaps[2.0 * delta / speed] = (f"its thermal walls keep the gas warmer than "
+                                         f"{COLDEST_DRIVEN:g} of their temperature (an "
+                                         f"estimate with a wide margin)")
         if not gaps:
             return math.inf, ""
         gap = min(gaps)

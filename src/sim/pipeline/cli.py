@@ -234,8 +234,11 @@ def main():
         sweep_stop.clear(sweep_dir)
         if len(cli_exits.STOPPED_BY) == 1:  # the signal came to a worker, not here
             stopped_by(asked)
-        print(f"sim: sweep {stopped()}; the same command with hydra.sweep.dir={sweep_dir} "
-              f"continues its jobs", file=sys.stderr)
+        begun = any(Path(sweep_dir).rglob(configs[0].output.file))
+        print(f"sim: sweep {stopped()}" + (
+            f"; the same command with hydra.sweep.dir={sweep_dir} continues its jobs" if begun
+            else f" before any run began; the same command with hydra.sweep.dir={sweep_dir} "
+                 f"runs it whole"), file=sys.stderr)
         sys.exit(stopped_status())  # atexit ends joblib's workers
     if callbacks.FAILED_JOBS:
         sys.exit(EXIT_RUN_FILE)

@@ -140,6 +140,9 @@ def validate(cfg: Any) -> None:
     if d.speed is not None and d.temperature is not None:
         raise ConfigError("disks.speed", d.speed,
                           "give disks.speed or disks.temperature (set the other to null)")
+    if d.speed is None and d.temperature is None and scene.gas_like:
+        raise ConfigError("disks.speed", None, "a speed, or a temperature in "
+                          "disks.temperature: one of the two (both are null)")
     positive("disks.speed", d.speed, zero=True)
     positive("disks.temperature", d.temperature, zero=True)
     if d.placement not in ("random", "lattice", "melted", "auto"):

@@ -185,12 +185,18 @@ def joblib_workers(args, jobs):
     to no more workers than jobs, unless the command line sets it
     (:func:`sim.pipeline.sweep_stop.worker_count`)."""
     launcher = hydra_settings(args).hydra.launcher
-    if not str(launcher.get("_target_", "")).endswith("JoblibLauncher") \
-            or value_of(args, "hydra.launcher.n_jobs") is not None:
+    if not str(launcher.get("_target_", "")).endswith("JoblibLauncher"):
         return args
     n_jobs = int(launcher.n_jobs) if launcher.get("n_jobs") is not None else -1
+    cores = os.cpu_count() or 1
+    if n_jobs == 0 or n_jobs < -cores:
+        fail(ConfigError("hydra.launcher.n_jobs", n_jobs, f"the number of workers, a whole "
+                         f"number ≥ 1, or −1 … −{cores} for all the {cores} cores but "
+                         f"|n_jobs| − 1"))
+    if value_of(args, "hydra.launcher.n_jobs") is not None:
+        return args
     return with_value(args, "hydra.launcher.n_jobs",
-                      sweep_stop.worker_count(n_jobs, jobs, os.cpu_count() or 1))
+                      sweep_stop.worker_count(n_jobs, jobs, cores))
 
 
 def check_job_folders(args):
@@ -201,6 +207,8 @@ def check_job_folders(args):
     if subdir == "${hydra.job.num}":
         return
     jobs = {}
+    inside = "a folder name inside hydra.sweep.dir that differs between jobs, such as " \
+             "${hydra.job.num}"
     for number, combination in enumerate(combinations(args)):
         cfg = compose_overrides(combination, hydra_config=True)
         cfg.hydra.job.num = number
@@ -209,11 +217,12 @@ def check_job_folders(args):
             folder = os.path.normpath(str(cfg.hydra.sweep.subdir))
         except Exception:  # a resolver only a running job has: each job checks its folder
             return
-        if folder in jobs:
+        if os.path.isabs(folder) or folder.split(os.sep)[0] in (os.pardir, os.curdir):
             fail(ConfigError("hydra.sweep.subdir", subdir,
-                             f"a folder name that differs between jobs, such as "
-                             f"${{hydra.job.num}} (jobs {jobs[folder]} and {number} would "
-                             f"both write {folder})"))
+                             f"{inside} (job {number} would write {folder})"))
+        if folder in jobs:
+            fail(ConfigError("hydra.sweep.subdir", subdir, f"{inside} (jobs {jobs[folder]} "
+                             f"and {number} would both write {folder})"))
         jobs[folder] = number
 
 

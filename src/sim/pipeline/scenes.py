@@ -356,6 +356,10 @@ def _crater_count(cfg):
     return int(cfg.bed.n) + 1, "bed.n"
 
 
+#: the longest settling of a bed, in free-fall times √(2L/g) across the box
+SETTLE_FALLS = 100
+
+
 def _check_crater(c):
     """The bed and its settling under gravity; the projectile inside the box, above the bed."""
     _check_bed(c)
@@ -364,6 +368,13 @@ def _check_crater(c):
     if b.settle_time is not None and not any(c.gravity):
         raise ConfigError("bed.settle_time", b.settle_time,
                           "null without gravity (nothing settles); set gravity=[0,-1]")
+    if b.settle_time is not None:  # a bed settles within a few free-fall times
+        fall = math.sqrt(2.0 * float(max(c.box.size)) / math.hypot(*c.gravity))
+        if b.settle_time > SETTLE_FALLS * fall:
+            raise ConfigError("bed.settle_time", b.settle_time,
+                              f"at most {SETTLE_FALLS} free-fall times across the box, "
+                              f"{SETTLE_FALLS} √(2L/g) = {SETTLE_FALLS * fall:.4g} here (a bed "
+                              f"settles within a few)")
     positive("projectile.radius", p.radius, allow_none=False)
     resolvable(c, "projectile.radius", p.radius)
     positive("projectile.speed", p.speed, zero=True, allow_none=False)

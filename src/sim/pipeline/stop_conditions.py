@@ -17,10 +17,6 @@ import numpy as np
 
 from sim.pipeline.config import ConfigError
 
-#: Above this many disks the pairwise test of :func:`_disks_never_touch` is skipped (it is
-#: O(N²) in memory); scenes of disks that provably never meet are small hand-made ones.
-PAIRWISE_LIMIT = 2000
-
 
 def at_rest(fraction):
     """Stop predicate of ``stop.at_rest``: the translational kinetic energy of every species
@@ -56,36 +52,6 @@ def already_met(engine, cfg):
     return None
 
 
-def _disks_never_touch(engine):
-    """Whether no two disks of ``engine`` can ever touch: no force acts between contacts
-    (no gravity, every wall still and not thermal), and every pair either moves with one
-    velocity in a periodic box, or keeps an axis fixed on which the two are further apart
-    than contact (a disk with v_x = 0 keeps its x until its first contact, also when it
-    bounces off the walls along y)."""
-    if engine.n < 2:
-        return True
-    if engine.gravity is not None or engine.wall_motion is not None \
-            or engine.wall_temperature is not None or engine.n > PAIRWISE_LIMIT:
-        return False
-    position, velocity = engine.positions(), engine.velocities()
-    one_velocity = np.all(engine.periodic) and np.all(velocity == velocity[0])
-    if np.any(np.all(velocity != 0.0, axis=1)) and not one_velocity:
-        return False  # a disk moving along no axis may meet any other: no pairs to test
-    radius = engine.radius
-    pairs = np.triu_indices(engine.n, 1)
-    sigma = radius[pairs[0]] + radius[pairs[1]]
-    never = np.zeros(sigma.size, dtype=bool)
-    if np.all(engine.periodic):
-        never |= np.all(velocity[pairs[0]] == velocity[pairs[1]], axis=1)
-    for axis in range(2):
-        fixed = velocity[:, axis] == 0.0
-        gap = np.abs(position[pairs[0], axis] - position[pairs[1], axis])
-        if engine.periodic[axis]:
-            gap = np.minimum(gap, engine.box[axis] - gap)
-        never |= fixed[pairs[0]] & fixed[pairs[1]] & (gap >= sigma)
-    return bool(np.all(never))
-
-
 def _dissipates(engine, never_touch):
     """Whether any contact can lose energy: of two disks that can meet, or with a wall (the
     engine's energy fraction counts what contacts dissipate)."""
@@ -113,7 +79,7 @@ def check_reachable(cfg, engine):
             and engine.wall_motion is None:
         return  # nothing moves: the run ends at once with no events left
     why = {}
-    never_touch = _disks_never_touch(engine)
+    never_touch = engine.disks_never_touch()
     if s.collisions is not None and never_touch:
         why["stop.collisions"] = ("one disk has no other to collide with" if engine.n == 1
                                   else "these disks never touch one another")
