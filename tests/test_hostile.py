@@ -942,6 +942,7 @@ def test_a_live_run_ends_on_sigint_with_its_file_whole(live_run):
     assert not hidden_leftovers(folder)
 
 
+@pytest.mark.slow  # beside the quick suite's runs of the same path
 def test_four_runs_started_together_get_four_folders(tmp_path):
     processes = [start(*SMALL, f"seed={k}", cwd=tmp_path) for k in range(4)]
     results = [finish(p) for p in processes]
@@ -1036,6 +1037,7 @@ def test_a_flag_hydra_refuses_leaves_no_run_folder(tmp_path):
     assert tree(tmp_path) == {}
 
 
+@pytest.mark.slow  # beside the quick suite's runs of the same path
 def test_a_sweep_into_the_default_sweep_folder_runs_with_the_flag_first(tmp_path):
     """No hydra.sweep.dir, and the flag first as Hydra's documents write it (``-m`` last, as
     the README writes it, in the sweeps above)."""
@@ -1104,7 +1106,8 @@ def test_a_file_size_limit_at_the_first_write_is_one_line_exit_1(tmp_path):
 
 #: moments of a SIGKILL: early in start-up, when the run folder, the part file and the run
 #: file appear, and in the run; the quick suite takes one of each phase
-KILL_MOMENTS = [pytest.param("5ms", marks=pytest.mark.slow), "50ms", "folder-appears",
+KILL_MOMENTS = [pytest.param("5ms", marks=pytest.mark.slow),
+                pytest.param("50ms", marks=pytest.mark.slow), "folder-appears",
                 "part-appears", pytest.param("file-appears", marks=pytest.mark.slow),
                 "file+0.3s"]
 
@@ -1153,6 +1156,7 @@ def test_a_wall_clock_budget_ends_a_run_that_snapshots_every_collision(tmp_path)
     assert summary(tmp_path / "run" / "run.h5", verify=False)["stop_reason"] == "wall_seconds"
 
 
+@pytest.mark.slow  # beside the quick suite's runs of the same path
 def test_sigterm_ends_a_run_resumably_and_resume_finishes_it(tmp_path):
     process = start(*FOREVER, "hydra.run.dir=X", cwd=tmp_path)
     try:
@@ -1186,9 +1190,10 @@ def still_running(pids):
     return running
 
 
-@pytest.mark.parametrize("to, how, seeds", [("the workers", signal.SIGTERM, "0,1"),
-                                             ("the process group", signal.SIGINT, "0,1"),
-                                             ("the command", signal.SIGTERM, "0,1,2")])
+@pytest.mark.parametrize("to, how, seeds", [  # quick: the workers; the group is quick below
+    ("the workers", signal.SIGTERM, "0,1"),
+    pytest.param("the process group", signal.SIGINT, "0,1", marks=pytest.mark.slow),
+    pytest.param("the command", signal.SIGTERM, "0,1,2", marks=pytest.mark.slow)])
 def test_a_signal_stops_a_sweep_whole(to, how, seeds, tmp_path):
     """However a signal reaches a sweep (a scheduler signals the workers, Ctrl-C the process
     group, kill the command): every running job ends with its final snapshot and checkpoint,
@@ -1243,7 +1248,7 @@ if "--process-name" in sys.argv:  # loky's worker, not the sweep or a resource t
 """
 
 
-@pytest.mark.parametrize("moment", ["joblib", "hydra"])
+@pytest.mark.parametrize("moment", ["joblib", pytest.param("hydra", marks=pytest.mark.slow)])
 def test_ctrl_c_as_a_sweep_worker_starts_stops_the_sweep_in_one_line(moment, tmp_path):
     """Ctrl-C while a worker starts (importing joblib, before it can take signals; importing
     hydra, as it reads its first job): no worker dies of it, no traceback, exit 130, no job
