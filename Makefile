@@ -40,8 +40,9 @@ validate: $(STAMP)  ## every test, slow physics runs included; the table into ou
 tutorials: $(STAMP)  ## run the tutorial notebooks (nbmake)
 	$(PY) -m pytest -q -p no:cacheprovider --nbmake --nbmake-timeout=600 docs/tutorials
 
-figures: $(STAMP)  ## every figure into outputs/figures/, the README's picture into docs/results/ (QUICK=1: small versions only)
+figures: $(STAMP)  ## every figure into outputs/figures/, their web versions and the README's picture into docs/results/ (QUICK=1: small versions only)
 	$(PY) -m sim.figures $(if $(QUICK),--quick)
+	$(if $(QUICK),,$(PY) -m sim.figures.web --target $(RESULTS)/figures)
 	$(if $(QUICK),,cp outputs/figures/fig08_crater_grid.png $(RESULTS)/crater.png)
 
 accuracy: $(STAMP)  ## accuracy against wall time for every knob into outputs/accuracy_cost/ and docs/results/ (QUICK=1: fewer settings, not copied)

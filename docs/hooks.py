@@ -3,8 +3,9 @@
 - ``configuration.md``: every scene and config key, from the schema and the comments of
   ``conf/config.yaml`` (:func:`sim.pipeline.config_reference.markdown`, the text of ``--help``).
 - ``figures.md``: the gallery, one section per figure stage of :mod:`sim.figures` (its
-  docstring), with the image and the numbers that ``make figures`` wrote into
-  ``outputs/figures/`` when they are there (``QUICK=1`` versions otherwise).
+  docstring), with the web image and the numbers that ``make figures`` wrote into
+  ``docs/results/figures/`` (:mod:`sim.figures.web`), or else the ``QUICK=1`` versions of
+  ``outputs/figures/quick/``.
 - ``api/engine.md``: the table of the effects' Engine keywords (each effect module's
   ``KEYWORDS``), which the Engine's docstring gains only when the module is imported.
 - every page: the Sphinx roles of the docstrings (``:class:`Engine` ``) shown as the name.
@@ -23,6 +24,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 FIGURES = ROOT / "outputs" / "figures"
+#: the web versions that ``make figures`` writes and the repository keeps (sim.figures.web)
+PUBLISHED = ROOT / "docs" / "results" / "figures"
 #: where api/engine.md shows the effects' keywords
 EFFECT_KEYWORDS = "<!-- effect keywords -->"
 #: number files at most this large are shown as tables in the gallery (bytes)
@@ -78,7 +81,7 @@ def gallery():
         text = ROLE.sub(r"`\1`", stage.__doc__.strip())
         title = heading(text)
         lines += [f"## {title}", "", text, ""]
-        folder = next((f for f in (FIGURES, FIGURES / "quick")
+        folder = next((f for f in (PUBLISHED, FIGURES / "quick")
                        if (f / f"{stage.NAME}.png").exists()), None)
         if folder is None:
             if stage_name != "movies":
