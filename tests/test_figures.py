@@ -78,6 +78,9 @@ def check_crater_grid(out):
     grid = numbers(out, "crater_grid")
     assert np.all(grid[:, 2] > np.pi * 0.05**2)  # the crater is larger than the projectile
     assert np.all(grid[:, 2] < 0.5)  # and smaller than the bed
+    # less the cells the projectile covers: smaller where a cell lies wholly under it
+    assert np.all((grid[:, 3] >= 0) & (grid[:, 3] <= grid[:, 2]))
+    assert np.any(grid[:, 3] < grid[:, 2])
 
 
 def check_crater_radius(out):
