@@ -42,9 +42,11 @@ def check_single_disk(out):
 
 def check_two_disks(out):
     two = key_values(out, "two_disks")
-    # the measured loss of order agrees with ln(R / 1e-12) / ln(growth per collision)
-    assert float(two["order_lost_after_collisions"]) == pytest.approx(
-        float(two["estimate_collisions"]), abs=3)
+    # defocusing by 2ℓ/R at most per collision: order is lost no sooner than it predicts, and
+    # within twice that; the growth measured is below 2ℓ/R
+    predicted = float(two["predicted_collisions"])
+    assert predicted <= float(two["order_lost_after_collisions"]) <= 2 * predicted
+    assert 1 < float(two["growth_per_collision"]) < float(two["defocusing_2l_over_r"])
 
 
 def check_scattering(out):
