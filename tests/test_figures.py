@@ -66,6 +66,9 @@ def check_maxwell_boltzmann(out):
 def check_mixture(out):
     mixture = numbers(out, "mixture")
     assert np.all(mixture[:, 2] > 1e-3)  # both species Maxwellian at the common T
+    # equipartition, T₂/T₁ = 1, within four standard errors of the independent runs
+    ratio, error = mixture[0, 4], mixture[0, 5]
+    assert error > 0 and abs(ratio - 1.0) < 4 * error
 
 
 def check_mixture_cooling(out):
