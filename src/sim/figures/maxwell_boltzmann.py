@@ -3,14 +3,15 @@
 Left: from equal speeds, the mean speed and the speed moment ratio K = ⟨v⁴⟩/⟨v²⟩² of each
 snapshot against collisions per disk, each over its Maxwell–Boltzmann value (√(πT/2m) and
 2). Equilibration is judged by K, which sees the shape of the distribution, not by the mean
-speed: the first snapshot after which K's mean over the last N collisions stays within four
-standard deviations (of that mean) of its late half's mean (the mean speed, judged alike,
-settles sooner; the seed study's "about 3N collisions" read it). Beside it, the
-Kolmogorov–Smirnov p-value of one snapshot's N speeds (a fixed sample size, samples within a
-snapshot nearly independent) at that snapshot and at the last: pooling ever more snapshots
-would reject in the end, since a finite isolated gas is not exactly Maxwellian (its energy
-is fixed). Right: the histogram of speeds pooled from snapshots every N collisions after
-equilibration (200 000 collisions at full size) against
+speed: the first snapshot at which K's mean over the last N collisions has gone 95 % of its
+way to the mean of its late half (:func:`settled_index`, three relaxation times of an
+exponential approach; the mean speed, judged alike, settles sooner; the seed study's "about
+3N collisions" read it). Beside it, the Kolmogorov–Smirnov p-value of one snapshot's N
+speeds (a fixed sample size, samples within a snapshot nearly independent) at that snapshot
+and at the last: pooling ever more snapshots would reject in the end, since a finite
+isolated gas is not exactly Maxwellian (its energy is fixed). Right: the histogram of speeds
+pooled from snapshots every N collisions after equilibration (200 000 collisions at full
+size) against
 f(v) = (m v / T) exp(−m v² / 2T), T = E/N.
 """
 
@@ -27,13 +28,19 @@ NAME = "fig05_maxwell_boltzmann"
 runs = gas_snapshot.runs
 
 
-def equilibration_index(series, tail=0.5, width=4.0):
-    """First index after which ``series`` stays within ``width`` standard deviations of the
-    mean of its last ``tail`` fraction."""
-    late = series[int(len(series) * (1 - tail)):]
-    centre, spread = late.mean(), late.std()
-    outside = np.flatnonzero(np.abs(series - centre) > width * spread)
-    return int(outside[-1] + 1) if outside.size else 0
+#: the share of its way to the late level at which a relaxation counts as done (three
+#: relaxation times of an exponential approach)
+SETTLED = 0.95
+
+
+def settled_index(series, every_n, tail=0.5):
+    """The first snapshot at which the mean of ``series`` over the last ``every_n`` snapshots
+    (N collisions) has gone :data:`SETTLED` of its way from its first value to the mean of
+    the last ``tail`` fraction of ``series``."""
+    smooth = np.convolve(series, np.ones(every_n) / every_n, "valid")
+    level = series[int(len(series) * (1 - tail)):].mean()
+    done = np.flatnonzero((smooth - smooth[0]) / (level - smooth[0]) >= SETTLED)
+    return every_n - 1 + (int(done[0]) if done.size else 0)
 
 
 def draw(runs, sweeps, out_dir):
@@ -47,9 +54,7 @@ def draw(runs, sweeps, out_dir):
     mean_speed = speed.mean(axis=1)
     moments = np.mean(speed**4, axis=1) / np.mean(speed**2, axis=1) ** 2
     every_n = max(1, int(round(n / max(np.diff(collisions).mean(), 1))))
-    window = np.ones(every_n) / every_n  # means over N collisions; the first ends at every_n − 1
-    k0 = every_n - 1 + equilibration_index(np.convolve(moments, window, "valid"))
-    k_mean = every_n - 1 + equilibration_index(np.convolve(mean_speed, window, "valid"))
+    k0, k_mean = settled_index(moments, every_n), settled_index(mean_speed, every_n)
     pooled = speed[k0::every_n].ravel()
     cdf = lambda v: 1.0 - np.exp(-mass * v**2 / (2 * temperature))  # noqa: E731
     p_value = stats.kstest(speed[-1], cdf).pvalue
@@ -83,7 +88,7 @@ def draw(runs, sweeps, out_dir):
                np.column_stack([collisions, mean_speed, moments]), delimiter=",",
                header="collisions,mean_speed,speed_moment_ratio", comments="")
     (out_dir / f"{NAME}.txt").write_text("".join(f"{key}={value}\n" for key, value in (
-        ("equilibration_collisions", collisions[k0]),
+        ("disks", n), ("equilibration_collisions", collisions[k0]),
         ("equilibration_by_the_mean_speed_alone", collisions[k_mean]),
         ("ks_pvalue_at_equilibration", p_at_equilibration), ("ks_pvalue", p_value),
         ("late_speed_moment_ratio", moments[k0:].mean()), ("temperature", temperature))))

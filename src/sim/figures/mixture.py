@@ -5,11 +5,13 @@ and the ratio of the two species' temperatures, which equipartition makes 1 exac
 isolated gas of quadratic degrees of freedom, whatever the masses).
 
 T_s is the mean kinetic energy of a disk of species s (2D: m v²/2 = T), each run's mean over
-its snapshots after equilibration. Those snapshots are correlated over many collisions per
+its snapshots after equilibration (once each species' mean energy over N collisions has
+settled, :func:`sim.figures.maxwell_boltzmann.settled_index`; from equal speeds the heavy
+species starts four times hotter). Those snapshots are correlated over many collisions per
 disk (the slow collective modes of a walled box), so one run's scatter understates the error
 of its mean: T₂/T₁ = 1.016 ± 0.006 read from one run's snapshots was a fluctuation of that
-kind. The error is the standard error over ``RUNS`` independent runs (seeds), and the
-ratio is drawn with it.
+kind. The error is the standard error over ``RUNS`` independent runs (seeds), and the ratio
+is drawn with it.
 """
 
 import numpy as np
@@ -18,7 +20,7 @@ from scipy import stats
 from sim.analysis.datasets import open_sweep
 from sim.analysis.theory import maxwell_speed_cdf, maxwell_speed_pdf
 from sim.checks.rows import block_means
-from sim.figures.maxwell_boltzmann import equilibration_index
+from sim.figures.maxwell_boltzmann import settled_index
 from sim.figures.style import figure, save
 
 NAME = "fig06_mixture"
@@ -46,11 +48,12 @@ def draw(runs, sweeps, out_dir):
     speed = np.hypot(ds["velocity"].values[..., 0], ds["velocity"].values[..., 1])
     energy = 0.5 * mass[:, None, :] * speed**2  # [run, snapshot, disk]
     temperature = float(ds["kinetic_energy"].values[0, -1]) / n
+    every_n = max(1, int(round(n / np.diff(ds["collisions"].values[0]).mean())))
     ratios, starts = [], []
     for run in range(ds.sizes["seed"]):
         species = [kind[run] == s for s in (0, 1)]
-        # equilibrated once the mean energy of each species has settled
-        k0 = max(equilibration_index(energy[run][:, at].mean(axis=1)) for at in species)
+        # equilibrated once each species' mean energy over N collisions has settled
+        k0 = max(settled_index(energy[run][:, at].mean(axis=1), every_n) for at in species)
         ratios.append(energy[run, k0:][:, species[1]].mean()
                       / energy[run, k0:][:, species[0]].mean())
         starts.append(k0)
