@@ -116,13 +116,15 @@ class Running:
         piston-jam guard (:meth:`_check_piston`) runs after every chunk, whatever ended it.
         Chunk sizes change no result: the same inputs give the same bits.
         """
-        given = dict(zip(STOP_NAMES, (contacts, collisions, events, time, energy_fraction,
-                                      wall_seconds, until), strict=True))  # as written
+        given = {name: value for name, value in zip(STOP_NAMES, (
+            contacts, collisions, events, time, energy_fraction, wall_seconds, until),
+            strict=True) if value is not None}  # as written, for a refusal
         (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
          chunk_events) = check_stop(contacts, collisions, events, time, energy_fraction,
                                     wall_seconds, until, chunk_events)
-        self._refuse_unreachable({name: value for name, value in given.items()
-                                  if value is not None}, collisions, contacts, energy_fraction)
+        self._refuse_unreachable(given, dict(zip(STOP_NAMES, (
+            contacts, collisions, events, time, energy_fraction, wall_seconds, until),
+            strict=True)))
         big = np.iinfo(np.int64).max
         max_contacts = big if contacts is None else contacts
         max_events = big if events is None else events
@@ -165,35 +167,55 @@ class Running:
                 if until is not None and until(self):
                     return "predicate"
 
-    def _refuse_unreachable(self, given, collisions, contacts, energy_fraction):
+    def _refuse_unreachable(self, given, checked):
         """:func:`check_reachable` for the stop conditions ``given`` to :meth:`run` (name →
-        value as given), with the counts and fraction that :func:`check_stop` made of them."""
-        if {"events", "wall_seconds", "until"} & set(given):
-            return  # a condition that always holds in the end (until: its caller's to say)
+        value as given), ``checked`` (name → value) as :func:`check_stop` made them: refused
+        only when none may hold (:meth:`never_holds`), asked until one may."""
+        if self.still:
+            return  # the run ends at once: no event is left
         never = {}
-        moves = (np.any(self.velocities() != 0.0) or self.gravity is not None
-                 or self.wall_motion is not None)
-        touch = ({"collisions", "contacts"} & set(given)) and moves
-        never_touch = bool(touch) and self.disks_never_touch()
-        if collisions is not None and collisions > self.collisions and never_touch:
-            never["collisions"] = ("a count these disks reach: "
-                                   + ("one disk has no other to collide with" if self.n == 1
-                                      else "they never touch one another"))
-        if contacts is not None and contacts > self.contacts and never_touch \
-                and bool(np.all(self.periodic)):
-            never["contacts"] = ("a count these disks reach: a periodic box has no walls and "
-                                 "they never touch one another")
-        if energy_fraction is not None and energy_fraction < 1.0 \
-                and not (self.disk_contacts_dissipate or self.wall_contacts_dissipate) \
-                and self.dissipated_energy < self.initial_energy * (1.0 - energy_fraction):
-            never["energy_fraction"] = ("a fraction this engine can reach: no contact of it "
-                                        "dissipates energy (elastic disks and walls, smooth or "
-                                        "elastic rough contacts)")
-        if "time" in given:
-            latest, reason = self.latest_time()
-            if float(given["time"]) > latest:
-                never["time"] = f"a time this engine can reach: {reason}"
+        for name in given:
+            reason = self.never_holds(name, checked[name])
+            if reason is None:
+                return
+            never[name] = reason
         check_reachable(given, never)
+
+    @property
+    def still(self):
+        """Whether nothing moves, nor ever will: no disk moving, no gravity, no moving wall (a
+        run ends at once, stop reason ``no_events``)."""
+        return (self.gravity is None and self.wall_motion is None
+                and not np.any(self.velocities() != 0.0))
+
+    def never_holds(self, name, value):
+        """Why the stop condition ``name`` = ``value`` of :meth:`run` (as :func:`check_stop`
+        makes it) can never hold from this state, as what is allowed instead; None when it
+        may. The command line asks the same of its ``stop``
+        (:func:`sim.pipeline.stop_conditions.check_reachable`)."""
+        if name == "time":
+            latest, reason = self.latest_time()
+            return f"a time this engine can reach: {reason}" if value > latest else None
+        if name in ("collisions", "contacts"):
+            done = self.collisions if name == "collisions" else self.contacts
+            walls = name == "contacts" and not bool(np.all(self.periodic))
+            if value <= done or walls or not self.disks_never_touch():
+                return None
+            if name == "contacts":
+                return ("a count these disks reach: a periodic box has no walls and they never "
+                        "touch one another")
+            return ("a count these disks reach: "
+                    + ("one disk has no other to collide with" if self.n == 1
+                       else "they never touch one another"))
+        if name == "energy_fraction":
+            if value >= 1.0 or self.wall_contacts_dissipate \
+                    or self.dissipated_energy >= self.initial_energy * (1.0 - value) \
+                    or (self.disk_contacts_dissipate and not self.disks_never_touch()):
+                return None
+            return ("a fraction this engine can reach: no contact of it dissipates energy "
+                    "(elastic disks and walls, smooth or elastic rough contacts, or inelastic "
+                    "disks that never touch)")
+        return None  # events, wall_seconds and until hold in the end (until: its caller's say)
 
     def disks_never_touch(self):
         """Whether no two disks can ever touch: no force acts between contacts (no gravity,
@@ -206,16 +228,17 @@ class Running:
         if self.gravity is not None or self.wall_motion is not None \
                 or self.wall_temperature is not None:
             return False
-        position, velocity = self.positions(), self.velocities()
-        one_velocity = bool(np.all(self.periodic)) and bool(np.all(velocity == velocity[0]))
-        if one_velocity:
+        velocity = self.velocities()
+        periodic = bool(np.all(self.periodic))
+        if periodic and np.all(velocity == velocity[0]):
             return True
         if self.n > PAIRWISE_LIMIT or np.any(np.all(velocity != 0.0, axis=1)):
             return False  # a disk moving along no axis may meet any other: no pairs to test
+        position = self.positions()
         pairs = np.triu_indices(self.n, 1)
         sigma = self.radius[pairs[0]] + self.radius[pairs[1]]
         never = np.zeros(sigma.size, dtype=bool)
-        if np.all(self.periodic):
+        if periodic:
             never |= np.all(velocity[pairs[0]] == velocity[pairs[1]], axis=1)
         for axis in range(2):
             fixed = velocity[:, axis] == 0.0
@@ -263,27 +286,29 @@ class Running:
 
         Returns (that time, the reason in words)."""
         delta = float(np.max(self.disks.delta))
-        gaps = {}
+        gaps = []  # (gap, why, "at least" for a bound or "about" for an estimate)
         if self.gravity is not None:
             g = float(np.hypot(*self.gravity))
-            gaps[(2.0 + 2.0 * math.sqrt(2.0)) * math.sqrt(delta / g)] = "under gravity"
-        speed_squared = 2.0 * self.kinetic_energy() / float(self.mass.sum())
-        if self.conserves_kinetic_energy and speed_squared > TINY_SPEED_SQUARED:
-            gaps[2.0 * delta / math.sqrt(speed_squared)] = "the kinetic energy never changes"
+            gaps.append(((2.0 + 2.0 * math.sqrt(2.0)) * math.sqrt(delta / g), "under gravity",
+                         "at least"))
+        if self.conserves_kinetic_energy:
+            speed_squared = 2.0 * self.kinetic_energy() / float(self.mass.sum())
+            if speed_squared > TINY_SPEED_SQUARED:
+                gaps.append((2.0 * delta / math.sqrt(speed_squared),
+                             "the kinetic energy never changes", "at least"))
         if self.wall_temperature is not None:
             t_wall = float(np.nanmin(self.wall_temperature))
             speed = math.sqrt(2.0 * COLDEST_DRIVEN * t_wall / float(self.mass.max()))
-            gaps[2.0 * delta / speed] = (f"its thermal walls keep the gas warmer than "
-                                         f"{COLDEST_DRIVEN:g} of their temperature (an "
-                                         f"estimate with a wide margin)")
+            gaps.append((2.0 * delta / speed, f"its thermal walls keep the gas warmer than "
+                         f"{COLDEST_DRIVEN:g} of their temperature (an estimate with a wide "
+                         f"margin)", "about"))
         if not gaps:
             return math.inf, ""
-        gap = min(gaps)
+        gap, why, how = min(gaps)
         latest = self.time + (MAX_COUNT - self.events) * gap
-        reason = (f"{gaps[gap]}, so some event (a contact or a shell exit) comes at least "
-                  f"every {gap:.3g} time units, and the 2^62 events a run may count reach "
-                  f"t = {latest:.3g} at most")
-        return latest, reason
+        return latest, (f"{why}, so some event (a contact or a shell exit) comes {how} every "
+                        f"{gap:.3g} time units, and the 2^62 events a run may count reach "
+                        f"t = {latest:.3g} at most")
 
     def _check_piston(self):
         """Raise :class:`ClosedBoxError` when a piston has jammed the disks

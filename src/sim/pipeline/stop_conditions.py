@@ -52,49 +52,33 @@ def already_met(engine, cfg):
     return None
 
 
-def _dissipates(engine, never_touch):
-    """Whether any contact can lose energy: of two disks that can meet, or with a wall (the
-    engine's energy fraction counts what contacts dissipate)."""
-    return (engine.disk_contacts_dissipate and not never_touch) \
-        or engine.wall_contacts_dissipate
-
-
 def check_reachable(cfg, engine):
-    """Refuse (:class:`ConfigError` on ``stop``, or on ``stop.time``) a scene none of whose
-    stop conditions can ever hold for the initial state of ``engine``, or that reaches its
-    ``stop.time`` only after more events than the engine counts; see the module
-    docstring."""
+    """Refuse (:class:`ConfigError` on the ``stop`` key, or on ``stop`` for several) a scene
+    none of whose stop conditions can ever hold for the state of ``engine``: the engine says
+    why for each (:meth:`sim.engine.Engine.never_holds`, as for its own :meth:`run`), and
+    ``stop.at_rest`` where the kinetic energy never changes; see the module docstring."""
     s = cfg.stop
-    others = [s.collisions, s.contacts, s.wall_seconds]
-    if not engine.conserves_kinetic_energy:  # an energy condition may end the run first
-        others += [s.energy_fraction, s.at_rest]
-    if s.time is not None and all(x is None for x in others):
-        latest, reason = engine.latest_time()
-        if float(s.time) > latest:
-            raise ConfigError("stop.time", s.time, f"a time the run can reach: {reason}; or "
-                              f"add stop.collisions or stop.wall_seconds")
-    if s.time is not None or s.wall_seconds is not None:
-        return
-    if np.all(engine.velocities() == 0.0) and engine.gravity is None \
-            and engine.wall_motion is None:
+    if engine.still:
         return  # nothing moves: the run ends at once with no events left
+    given = {key: s[key] for key in ("collisions", "contacts", "time", "energy_fraction",
+                                     "wall_seconds", "at_rest") if s[key] is not None}
     why = {}
-    never_touch = engine.disks_never_touch()
-    if s.collisions is not None and never_touch:
-        why["stop.collisions"] = ("one disk has no other to collide with" if engine.n == 1
-                                  else "these disks never touch one another")
-    if s.contacts is not None and never_touch and np.all(engine.periodic):
-        why["stop.contacts"] = "a periodic box has no walls and these disks never touch"
-    if s.energy_fraction is not None and s.energy_fraction < 1.0 \
-            and not _dissipates(engine, never_touch):
-        why["stop.energy_fraction"] = "no contact dissipates energy (elastic disks and walls, " \
-                                      "or inelastic disks that never meet)"
-    if s.at_rest is not None and engine.conserves_kinetic_energy and engine.n_species == 1:
-        why["stop.at_rest"] = "the kinetic energy never changes"
-    given = [key for key in ("collisions", "contacts", "energy_fraction", "at_rest")
-             if s[key] is not None]
-    if given and len(why) == len(given):
-        reasons = "; ".join(f"{key}: {text}" for key, text in why.items())
-        raise ConfigError("stop", {key: s[key] for key in given},
-                          f"a condition the scene can meet ({reasons}); add stop.time or "
-                          f"stop.wall_seconds, or change the scene")
+    for key, value in given.items():
+        if key != "at_rest":
+            reason = engine.never_holds(key, value)
+        elif engine.conserves_kinetic_energy and engine.n_species == 1:
+            reason = "a condition of a scene whose kinetic energy changes (this one's never does)"
+        else:
+            reason = None
+        if reason is None:
+            return
+        why[key] = reason
+    if not why:
+        return
+    advice = ("add " + " or ".join(f"stop.{key}" for key in ("collisions", "time", "wall_seconds")
+                                   if key not in given) + ", or change the scene")
+    if len(why) == 1:
+        (key, reason), = why.items()
+        raise ConfigError(f"stop.{key}", given[key], f"{reason}; {advice}")
+    raise ConfigError("stop", given, "a condition the scene can meet (" + "; ".join(
+        f"stop.{key}: {reason}" for key, reason in why.items()) + f"); {advice}")

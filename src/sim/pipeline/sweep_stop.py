@@ -12,12 +12,13 @@ jobs still writing); the sweep's process then exits with 128 + the signal's numb
 clears the stop file (:func:`clear`), as does the next sweep into the folder. A second
 signal to the sweep's process ends it and its workers at once, as SIGKILL would.
 
-The sweep's process takes both signals with a handler of its own (:func:`guarded`), a job
-with another while it runs (:func:`job`). A joblib worker ignores them outside its jobs, from
-its start (:func:`worker_started`): a worker that a signal ended while it waited for a job
-would break joblib's pool, whose other workers are then killed mid-run. A worker whose sweep
-process has ended (SIGKILL) stops its job as at SIGTERM (:func:`requested`) rather than
-compute on for no one. The launcher starts no more workers than jobs (:func:`worker_count`).
+The sweep's process takes both signals in a thread and a handler of its own
+(:func:`guarded`), a job with another while it runs (:func:`job`). A joblib worker ignores
+them outside its jobs, from its start (:func:`worker_started`): a worker that a signal ended
+while it waited for a job would break joblib's pool, whose other workers are then killed
+mid-run. A worker whose sweep process has ended (SIGKILL) stops its job as at SIGTERM
+(:func:`requested`) rather than compute on for no one. The launcher starts no more workers
+than jobs (:func:`worker_count`).
 """
 
 import contextlib
@@ -126,6 +127,7 @@ def guarded(sweep_dir, taken, at_second_signal):
                 take(received.si_signo)
 
     resource_tracker.ensure_running()  # started later, it would unblock this thread's mask
+    # a thread that does not block them (one started before the block) still takes them
     previous = {number: signal.signal(number, take) for number in SIGNALS}
     mask = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
     over = threading.Event()
