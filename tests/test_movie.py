@@ -1,6 +1,6 @@
-"""Movies of runs (sim.figures.movie): frames evenly spaced in time, disks in free flight from the
-latest snapshot, drawn where the positions say; MP4 or GIF written whole; bad input is one line and
-exit status 2."""
+"""Movies of runs (sim.figures.movie): frames evenly spaced in time or at the snapshots, disks in
+free flight from the latest snapshot, drawn where the positions say, speeds on a scale up to the
+fastest; MP4 or GIF written whole; bad input is one line and exit status 2."""
 
 import os
 import subprocess
@@ -10,15 +10,30 @@ import warnings
 import imageio_ffmpeg
 import numpy as np
 import pytest
+from matplotlib import colormaps
 from PIL import Image
 from scipy import ndimage
 
 from sim.analysis.datasets import open_run
 from sim.figures import movie
-from sim.figures.movie.colors import cluster_rule
+from sim.figures.movie.colors import (
+    LOG_DECADES,
+    SpeedColors,
+    cluster_rule,
+    coloring,
+    fastest_speed,
+)
 from sim.figures.movie.layout import Layout
+from sim.figures.movie.make import clock_decimals
 from sim.figures.movie.picture import Picture
-from sim.figures.movie.snapshots import Snapshots, free_flight, latest_snapshots
+from sim.figures.movie.snapshots import (
+    Frame,
+    Snapshots,
+    free_flight,
+    latest_snapshots,
+    snapshot_frame_times,
+)
+from sim.pipeline.command import BadInput
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
@@ -170,6 +185,112 @@ def test_frames_across_contacts_are_noted_in_one_line(runs, tmp_path, capsys):
     assert "note: 2 of 2 frames lie between snapshots" in notes[0]
 
 
+def test_frames_at_snapshots_are_the_distinct_snapshot_times_in_the_span():
+    # uneven, as by collisions; the fourth is the third but for round-off, and counts as it
+    times = np.array([0.0, 0.1, 0.15, np.nextafter(0.15, 1.0), 0.7, 2.0])
+    np.testing.assert_array_equal(snapshot_frame_times(times), times[[0, 1, 3, 4, 5]])
+    np.testing.assert_array_equal(snapshot_frame_times(times, 0.1, 0.7), times[[1, 3, 4]])
+    np.testing.assert_array_equal(snapshot_frame_times(times, 0.12, 1.12), times[[3, 4]])
+    with pytest.raises(BadInput, match="no snapshot from t = 0.2 to 0.3"):
+        snapshot_frame_times(times, 0.2, 0.3)
+    with pytest.raises(BadInput, match="5 snapshots from t = 0 to 2, at most 4 frames"):
+        snapshot_frame_times(times, limit=4, why="a test's limit")
+    with pytest.raises(BadInput, match="--start"):
+        snapshot_frame_times(times, -1.0)
+
+
+def test_a_movie_at_snapshots_draws_each_snapshot_at_its_own_time(runs, tmp_path, monkeypatch):
+    render = Picture.render
+    drawn = []
+
+    def recording(picture, frame):
+        drawn.append(frame)
+        return render(picture, frame)
+
+    monkeypatch.setattr(Picture, "render", recording)
+    out = tmp_path / "m.gif"
+    assert movie.main([str(runs["periodic"]), "--out", str(out), "--at-snapshots",
+                       "--start", "0.505", "--stop", "0.6"]) == 0
+    with open_run(runs["periodic"]) as ds:
+        time = ds["time"].values
+        position = ds["position"].values
+    inside = np.flatnonzero((time >= 0.505) & (time <= 0.6))
+    assert inside.size == 10  # snapshots 0.51, …, 0.60
+    assert [f.snapshot for f in drawn] == inside.tolist()
+    assert [f.time for f in drawn] == time[inside].tolist()
+    for frame in drawn:  # no free flight: the snapshot itself
+        np.testing.assert_array_equal(frame.position, position[frame.snapshot])
+    with Image.open(out) as image:
+        assert image.n_frames == inside.size
+
+
+def test_a_count_with_frames_at_snapshots_is_refused_before_any_work(runs, no_work):
+    for count in ({"frames": 3}, {"duration": 1.0}):
+        with pytest.raises(BadInput, match="--at-snapshots draws one frame at each snapshot"):
+            movie.make_movie(runs["periodic"], at_snapshots=True, **count)
+
+
+def test_more_snapshots_than_a_gif_holds_are_refused(runs, tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(movie.make, "available_memory", lambda: 2 * 3 * 912 * 704)
+    assert movie.main([str(runs["periodic"]), "--out", str(tmp_path / "m.gif"),
+                       "--at-snapshots"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--at-snapshots: 201 snapshots" in err
+    assert "at most 3 frames" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_clock_tells_the_closest_frames_apart():
+    assert clock_decimals(np.linspace(8.0, 14.5, 521)) == 3  # 0.0125 apart
+    assert clock_decimals(np.linspace(0.0, 1.0, 11)) == 2  # 0.1 apart, less round-off
+    assert clock_decimals(np.array([0.0, 0.004, 0.5, 3.0])) == 4  # the closest two
+    assert clock_decimals(np.array([2.0])) == 4
+
+
+def speed_frame(speeds):
+    """A :class:`Frame` of disks moving along x at ``speeds``."""
+    speeds = np.asarray(speeds, dtype=np.float64)
+    velocity = np.stack([speeds, np.zeros_like(speeds)], axis=1)
+    return Frame(0.0, 0, np.zeros_like(velocity), velocity)
+
+
+def test_the_speed_scale_reaches_the_fastest_disk_without_saturating():
+    # an impact: a projectile at 10 above a bed moving at most 1, the 99th percentile of the
+    # speeds
+    impact = speed_frame(np.append(np.linspace(0.0, 1.0, 200), 10.0))
+    fastest = fastest_speed([impact, speed_frame([0.0, 5.0])])
+    assert fastest == 10.0
+    viridis = colormaps["viridis"]
+    linear, log = SpeedColors(fastest), SpeedColors(fastest, "log")
+    np.testing.assert_allclose(linear.norm([0.0, 5.0, 10.0]), [0.0, 0.5, 1.0])
+    floor = fastest * 10.0**-LOG_DECADES
+    np.testing.assert_allclose(log.norm([floor, fastest * 10.0**(-LOG_DECADES / 2), fastest]),
+                               [0.0, 0.5, 1.0], atol=1e-12)
+    for scale in (linear, log):  # the projectile on the top colour, the bed well below it
+        colors = scale(impact)[0]
+        np.testing.assert_array_equal(colors[-1], viridis(1.0))
+        assert not np.any(np.all(colors[:-1] == viridis(1.0), axis=1))
+    # disks at rest, and slower than the log scale's floor, take its lowest colour
+    np.testing.assert_array_equal(log(speed_frame([0.0, 0.1 * floor]))[0], viridis([0.0, 0.0]))
+
+
+def test_a_movie_coloured_by_speed_scales_to_its_fastest_disk(runs, tmp_path):
+    with open_run(runs["walls_and_gravity"]) as ds:
+        snapshots = Snapshots(ds)
+        speed = np.hypot(*ds["velocity"].values.transpose(2, 0, 1))
+        times = snapshots.times
+        for scale in ("linear", "log"):
+            colors = coloring("speed", snapshots, times, ds["radius"].values,
+                              ds["mass"].values, scale)
+            assert colors.norm.vmax == speed.max()
+            assert colors.norm.vmin == (0.0 if scale == "linear"
+                                        else speed.max() * 10.0**-LOG_DECADES)
+    out = tmp_path / "log.gif"
+    assert movie.main([str(runs["walls_and_gravity"]), "--out", str(out), "--frames", "2",
+                       "--speed-scale", "log"]) == 0
+    assert out.is_file()
+
+
 def test_cluster_labels_follow_the_rule_of_the_observer(runs):
     with open_run(runs["periodic"]) as ds:
         labels = cluster_rule(Snapshots(ds), ds["radius"].values)
@@ -189,6 +310,9 @@ def test_cluster_labels_follow_the_rule_of_the_observer(runs):
     (["RUN", "--start", "-1"], "--start"),
     (["RUN", "--stop", "99"], "--stop"),
     (["RUN", "--color", "mood"], "--color"),
+    (["RUN", "--speed-scale", "loud"], "--speed-scale loud: one of linear, log"),
+    (["RUN", "--at-snapshots", "--frames", "3"], "not allowed with"),
+    (["RUN", "--at-snapshots", "--start", "0.101", "--stop", "0.109"], "no snapshot"),
     (["RUN", "--out", "movie.avi"], ".mp4 or .gif"),
     (["RUN", "--out", "nowhere/movie.mp4"], "no folder"),
     (["RUN", "--out", "not_a_run.h5/movie.mp4"], "no folder"),

@@ -1,8 +1,10 @@
-"""``python -m sim.figures.movie RUN.h5 [--out FILE] [--fps N] [--duration SECONDS | --frames N]
-[--color speed|species|cluster] [--start T] [--stop T]`` (also ``sim-movie``): a movie of a run.
+"""``python -m sim.figures.movie RUN.h5 [--out FILE] [--fps N]
+[--duration SECONDS | --frames N | --at-snapshots] [--color speed|species|cluster]
+[--speed-scale linear|log] [--start T] [--stop T]`` (also ``sim-movie``): a movie of a run.
 
-Frames evenly spaced in time (:mod:`sim.figures.movie.snapshots`), the disks coloured by
-speed, species or cluster (:mod:`sim.figures.movie.colors`).
+Frames evenly spaced in time, or one at each snapshot (:mod:`sim.figures.movie.snapshots`),
+the disks coloured by speed (a linear or log scale up to the fastest disk drawn), species or
+cluster (:mod:`sim.figures.movie.colors`).
 
 MP4 (frame sides multiples of 16) through imageio-ffmpeg's ffmpeg; a GIF through Pillow when
 FILE ends in .gif, or when ffmpeg is unavailable (said in one line). At most 100 000 frames
@@ -21,6 +23,7 @@ import argparse
 import math
 import sys
 
+from sim.figures.movie.colors import LOG_DECADES
 from sim.figures.movie.make import GIF_FRAME_BYTES, make_movie
 from sim.figures.movie.snapshots import DEFAULT_MAX_SECONDS, MAX_FPS, MAX_FRAMES, MIN_FPS
 from sim.pipeline.command import CannotWrite, Parser, run_command
@@ -52,7 +55,13 @@ def main(argv=None):
                         help=f"seconds of movie: --duration × --fps frames, {limit} (default: one "
                              f"frame per snapshot, at most {DEFAULT_MAX_SECONDS:g} s)")
     length.add_argument("--frames", type=whole_number, help=f"number of frames, {limit}")
+    length.add_argument("--at-snapshots", action="store_true",
+                        help="a frame at each snapshot from --start to --stop, at its own time "
+                             "(frames as far apart as the snapshots, e.g. in collisions)")
     parser.add_argument("--color", default="speed", help="speed (default), species or cluster")
+    parser.add_argument("--speed-scale", default="linear",
+                        help=f"speed colours from 0 (linear, default) or over {LOG_DECADES} "
+                             f"decades (log), up to the fastest disk drawn")
     parser.add_argument("--start", type=float, help="time of the first frame (first snapshot)")
     parser.add_argument("--stop", type=float, help="time of the last frame (last snapshot)")
 
@@ -60,7 +69,8 @@ def main(argv=None):
         args = parser.parse_args(argv)
         try:
             out = make_movie(args.run, args.out, args.fps, args.frames, args.duration,
-                             args.color, args.start, args.stop,
+                             args.color, args.start, args.stop, args.at_snapshots,
+                             args.speed_scale,
                              note=lambda line: print(line, file=sys.stderr, flush=True))
         except RunFileError:  # the run file read, not the movie written: bad input
             raise

@@ -1,21 +1,27 @@
-"""The disks' colours and their key: ``speed`` (one scale for the whole movie, up to the largest
-99th percentile of any frame's speeds), ``species``, or ``cluster`` (the run's ``clusters``
-observable at the snapshot drawn from, or the same rule, :class:`sim.analysis.observers.Clusters`,
-applied to the drawn positions when the run did not observe it: the largest cluster red, other
-clusters of at least ten disks dark grey, the rest light grey)."""
+"""The disks' colours and their key: ``speed`` (one scale for the whole movie, from 0, or on a
+log scale from :data:`LOG_DECADES` decades below, up to the fastest disk of any frame, so that
+no speed drawn saturates), ``species``, or ``cluster`` (the run's ``clusters`` observable at the
+snapshot drawn from, or the same rule, :class:`sim.analysis.observers.Clusters`, applied to the
+drawn positions when the run did not observe it: the largest cluster red, other clusters of at
+least ten disks dark grey, the rest light grey)."""
 
 from types import SimpleNamespace
 
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.cm import ScalarMappable
-from matplotlib.colors import Normalize, to_rgba
+from matplotlib.colors import LogNorm, Normalize, to_rgba
 from matplotlib.lines import Line2D
 
 from sim.analysis.observers import Clusters
 from sim.figures.movie.layout import TEXT_PIXELS, points
 
 COLORINGS = ("speed", "species", "cluster")
+#: speed colour scales: linear from 0, or logarithmic over LOG_DECADES decades
+SPEED_SCALES = ("linear", "log")
+#: decades of speed the log scale spans below the fastest disk; slower disks (and disks at
+#: rest) share its lowest colour
+LOG_DECADES = 3
 #: clusters of at least this many disks are drawn apart from free disks and small clusters
 SHOWN_CLUSTER = 10
 #: the gap (units of 2⟨R⟩) of cluster labels computed for a run that did not observe them
@@ -24,29 +30,36 @@ LARGEST_CLUSTER, LARGE_CLUSTER, SMALL_CLUSTER = "tab:red", "0.35", "0.78"
 
 
 class SpeedColors:
-    """Speed on one colour scale for the whole movie."""
+    """Speed (box units / time) on one colour scale for the whole movie, up to ``fastest``:
+    linear from 0, or (``scale`` "log") logarithmic from ``fastest`` / 10^LOG_DECADES."""
 
-    def __init__(self, limit):
-        self.norm = Normalize(0.0, limit if limit > 0.0 else 1.0)
+    def __init__(self, fastest, scale="linear"):
+        top = fastest if fastest > 0.0 else 1.0
+        self.norm = (Normalize(0.0, top) if scale == "linear"
+                     else LogNorm(top * 10.0**-LOG_DECADES, top))
+        self.scale = scale
         self.cmap = colormaps["viridis"]
 
     def __call__(self, frame):
         """RGBA float64[n, 4] of the disks of ``frame``, and a caption."""
-        return self.cmap(self.norm(np.hypot(frame.velocity[:, 0], frame.velocity[:, 1]))), ""
+        speed = np.hypot(frame.velocity[:, 0], frame.velocity[:, 1])
+        return self.cmap(self.norm(np.maximum(speed, self.norm.vmin))), ""
 
     def draw_key(self, figure, rect):
         """A colour bar in the strip ``rect`` (figure fractions) beside the box."""
         axes = figure.add_axes([rect[0] + 0.12 * rect[2], rect[1], 0.1 * rect[2], rect[3]])
-        figure.colorbar(ScalarMappable(self.norm, self.cmap), cax=axes, extend="max")
-        axes.set_ylabel("speed (box units / time)", fontsize=points(TEXT_PIXELS))
+        figure.colorbar(ScalarMappable(self.norm, self.cmap), cax=axes,
+                        extend="neither" if self.scale == "linear" else "min")
+        label = "speed (box units / time)"
+        axes.set_ylabel(label if self.scale == "linear" else f"{label}, log scale",
+                        fontsize=points(TEXT_PIXELS))
         axes.tick_params(labelsize=points(TEXT_PIXELS - 2))
 
 
-def speed_limit(frames):
-    """The largest 99th percentile of the speeds of any of ``frames``: colours saturate only
-    for the fastest 1 % of the disks of any frame."""
-    return max(float(np.percentile(np.hypot(f.velocity[:, 0], f.velocity[:, 1]), 99.0))
-               for f in frames)
+def fastest_speed(frames):
+    """The largest speed of any disk in any of ``frames`` (box units / time): the top of the
+    speed scale, which nothing drawn exceeds."""
+    return max(float(np.max(np.hypot(f.velocity[:, 0], f.velocity[:, 1]))) for f in frames)
 
 
 def _draw_legend(figure, rect, entries):
@@ -116,12 +129,12 @@ def cluster_rule(snapshots, radius):
     return lambda position: observer(disks, None, position, None)
 
 
-def coloring(color, snapshots, times, radius, mass):
+def coloring(color, snapshots, times, radius, mass, speed_scale="linear"):
     """The colours named ``color`` (one of :data:`COLORINGS`) of the run's disks, drawn at
-    ``times``."""
+    ``times``; speeds on the scale ``speed_scale`` (one of :data:`SPEED_SCALES`)."""
     ds = snapshots.ds
     if color == "speed":
-        return SpeedColors(speed_limit(snapshots.frames(times)))
+        return SpeedColors(fastest_speed(snapshots.frames(times)), speed_scale)
     if color == "species":
         return SpeciesColors(ds["species_id"].values.astype(np.int64), radius, mass)
     observed = ds["clusters"].values if "clusters" in ds else None

@@ -3,10 +3,15 @@
 Frames are evenly spaced in simulated time from --start to --stop (default: the first and the
 last snapshot), one per snapshot in between (at most 30 s of movie, and at most the limit of
 :func:`frame_count`) unless --frames or --duration (seconds of movie at --fps) says otherwise;
-a count asked for above that limit is refused before any work. A frame at time t draws each
-disk in free flight from the latest snapshot k at or before t, never back from a later one:
-r = r_k + v_k (t − t_k) + ½ g (t − t_k)² and v = v_k + g (t − t_k), g the run's gravity (box
-units / time²), r wrapped into the box along periodic axes.
+a count asked for above that limit is refused before any work. With --at-snapshots, a frame
+is drawn at each snapshot from --start to --stop instead, at the snapshot's own time
+(:func:`snapshot_frame_times`; the limit checked once the run's times are read): frames as far
+apart as the snapshots, e.g. a fixed number of collisions (``output.every_collisions``), which
+for a cooling gas keeps the motion per frame about even where equal steps in time would not.
+A frame at time t draws each disk in free flight from the latest snapshot k at or before t,
+never back from a later one: r = r_k + v_k (t − t_k) + ½ g (t − t_k)² and
+v = v_k + g (t − t_k), g the run's gravity (box units / time²), r wrapped into the box along
+periodic axes.
 Contacts between snapshots are not drawn: between two snapshots a disk may pass through a
 neighbour or a wall. A disk drawn a time s after its snapshot has met something with
 probability about s/τ (τ its mean free time); frames between snapshots lie on average half an
@@ -124,13 +129,18 @@ class Snapshots:
                 float(np.mean(interval)))
 
 
-def frame_count(fps, frames, duration, limit, why):
+def frame_count(fps, frames, duration, limit, why, at_snapshots=False):
     """The number of frames asked for: ``frames``, or ``duration`` × ``fps`` rounded; None when
-    neither is given (one per snapshot, :func:`frame_times`). BadInput, before any work, for a
-    rate, a length or a count out of range or a count above ``limit`` (``why``: its reason)."""
+    neither is given (one per snapshot, :func:`frame_times`, or at each snapshot when
+    ``at_snapshots``, :func:`snapshot_frame_times`). BadInput, before any work, for a rate, a
+    length or a count out of range, a count above ``limit`` (``why``: its reason), or a count
+    given with ``at_snapshots``."""
     if not MIN_FPS <= fps <= MAX_FPS:
         raise BadInput(f"--fps {fps}: a frame rate from {MIN_FPS:g} to {MAX_FPS:g} frames a "
                        f"second")
+    if at_snapshots and (frames is not None or duration is not None):
+        raise BadInput("--at-snapshots draws one frame at each snapshot: give neither "
+                       "--frames nor --duration with it")
     beyond = f"at most {limit} frames ({why})"
     if duration is not None:
         if not 0.0 < duration < math.inf:
@@ -146,11 +156,9 @@ def frame_count(fps, frames, duration, limit, why):
     return frames
 
 
-def frame_times(snapshot_times, fps, count=None, start=None, stop=None, limit=MAX_FRAMES):
-    """Times float64[F] of the frames, evenly spaced from ``start`` to ``stop`` (default the
-    first and last snapshot): ``count`` of them (:func:`frame_count`), or one per snapshot in
-    between (at most DEFAULT_MAX_SECONDS of movie at ``fps`` and at most ``limit``). Bad
-    values: BadInput."""
+def _span(snapshot_times, start, stop):
+    """(start, stop) of the frames: the first and last snapshot when None; BadInput unless
+    first ≤ start ≤ stop ≤ last."""
     first, last = float(snapshot_times[0]), float(snapshot_times[-1])
     start = first if start is None else start
     stop = last if stop is None else stop
@@ -158,6 +166,34 @@ def frame_times(snapshot_times, fps, count=None, start=None, stop=None, limit=MA
         raise BadInput(f"--start {start:.6g} and --stop {stop:.6g}: the run's snapshots span "
                          f"t = {first:.6g} to {last:.6g}; a frame is drawn only from a snapshot "
                          f"before it, so give {first:.6g} ≤ start ≤ stop ≤ {last:.6g}")
+    return start, stop
+
+
+def snapshot_frame_times(snapshot_times, start=None, stop=None, limit=MAX_FRAMES,
+                         why="MAX_FRAMES"):
+    """Times float64[F] of the frames drawn at the snapshots: each distinct snapshot time from
+    ``start`` to ``stop`` (default the first and last snapshot; times within
+    :func:`round_off` are one). BadInput when none lies there or more than ``limit`` do
+    (``why``: the limit's reason)."""
+    start, stop = _span(snapshot_times, start, stop)
+    tolerance = round_off(snapshot_times)
+    inside = snapshot_times[(snapshot_times >= start - tolerance)
+                            & (snapshot_times <= stop + tolerance)]
+    if not inside.size:
+        raise BadInput(f"--at-snapshots: no snapshot from t = {start:.6g} to {stop:.6g}")
+    times = inside[np.append(np.diff(inside) > tolerance, True)]
+    if times.size > limit:
+        raise BadInput(f"--at-snapshots: {times.size} snapshots from t = {start:.6g} to "
+                       f"{stop:.6g}, at most {limit} frames ({why}): narrow --start and --stop")
+    return times
+
+
+def frame_times(snapshot_times, fps, count=None, start=None, stop=None, limit=MAX_FRAMES):
+    """Times float64[F] of the frames, evenly spaced from ``start`` to ``stop`` (default the
+    first and last snapshot): ``count`` of them (:func:`frame_count`), or one per snapshot in
+    between (at most DEFAULT_MAX_SECONDS of movie at ``fps`` and at most ``limit``). Bad
+    values: BadInput."""
+    start, stop = _span(snapshot_times, start, stop)
     if count is None:
         inside = snapshot_times[(snapshot_times >= start) & (snapshot_times <= stop)]
         distinct = int(np.sum(np.diff(inside) > round_off(snapshot_times))) + 1
