@@ -58,6 +58,7 @@ bench: $(STAMP)  ## engine rate table (see benchmarks/engine_rate.py --help)
 speed: $(STAMP)  ## sim beside the C code of the fastest design, in one session, into docs/results/
 	$(PY) benchmarks/peer_speed.py --n 10000 100000 1000000 --phi 0.5 \
 		--json $(RESULTS)/speed.json --markdown $(RESULTS)/speed.md
+	$(PY) benchmarks/speed_figure.py $(RESULTS)/speed.json $(RESULTS)/speed.png
 
 readme: $(STAMP)  ## the README's numbers made anew from docs/results/
 	$(PY) docs/readme.py

@@ -10,9 +10,10 @@ temporary one). The C peer, a sim worker and, with ``--minimal``, the numba mini
 runs one chunk of collisions, in a shuffled order (as ``compare_builds.py`` does), and times
 it itself (C with CLOCK_MONOTONIC, Python with perf_counter). Printed per (N, φ): the
 best-chunk rate of each (the rate the machine disturbed least) and the median and quartiles
-over rounds of the same-round ratio sim / C; ``--json PATH`` writes the rows with the machine,
-the versions, the date and the command, and ``--markdown PATH`` the table with a line saying
-where and how it was measured (``make speed`` writes both into ``docs/results/``).
+over rounds of the same-round ratio sim / C; ``--json PATH`` writes the rows (with each
+round's rates) with the machine, the versions, the date and the command, and ``--markdown
+PATH`` the table with a line saying where and how it was measured (``make speed`` writes both
+into ``docs/results/``, and ``speed_figure.py`` draws the JSON).
 
     python benchmarks/peer_speed.py --n 10000 100000 --phi 0.5 --rounds 6
     python benchmarks/peer_speed.py --minimal --json outputs/peer_speed.json
@@ -102,7 +103,8 @@ def ask(process, collisions):
 
 
 def measure(executable, folder, n, phi, chunk, rounds, warmup, shell, minimal, seed=0):
-    """One row: best-chunk rates and the round-by-round ratios to the C peer."""
+    """One row: best-chunk rates, each round's rates (collisions per second) and the
+    median and quartiles of the round-by-round ratios to the C peer."""
     from engine_rate import equal_disks
     from sim.engine.sizing import shell_ratio
 
@@ -136,6 +138,7 @@ def measure(executable, folder, n, phi, chunk, rounds, warmup, shell, minimal, s
     row = {"n": n, "phi": phi, "shell": round(shell, 3), "chunk": chunk, "rounds": rounds}
     for kind in kinds:
         row[f"{kind}_collisions_per_s"] = round(max(rates[kind]))
+        row[f"{kind}_rates_per_round"] = [round(rate) for rate in rates[kind]]
     for kind in kinds[1:]:
         ratios = [a / c for a, c in zip(rates[kind], rates["c"], strict=True)]
         quartiles = statistics.quantiles(ratios, n=4) if rounds > 1 else [ratios[0]] * 3

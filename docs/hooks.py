@@ -6,6 +6,8 @@
   docstring), with the web image and the numbers that ``make figures`` wrote into
   ``docs/results/figures/`` (:mod:`sim.figures.web`), or else the ``QUICK=1`` versions of
   ``outputs/figures/quick/``.
+- ``results/speed.png``: the figure of the speed table that ``performance.md`` shows, put into
+  the site; the rest of ``docs/results/`` is left out of it, its text included into pages.
 - ``api/engine.md``: the table of the effects' Engine keywords (each effect module's
   ``KEYWORDS``), which the Engine's docstring gains only when the module is imported.
 - every page: the Sphinx roles of the docstrings (``:class:`Engine` ``) shown as the name.
@@ -18,7 +20,7 @@ import re
 import sys
 from pathlib import Path
 
-from mkdocs.structure.files import File
+from mkdocs.structure.files import File, InclusionLevel
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
@@ -30,6 +32,8 @@ PUBLISHED = ROOT / "docs" / "results" / "figures"
 EFFECT_KEYWORDS = "<!-- effect keywords -->"
 #: number files at most this large are shown as tables in the gallery (bytes)
 LARGEST_TABLE = 4000
+#: the images of docs/results/ that pages show, published although results/ is excluded
+SHOWN_RESULTS = ["results/speed.png"]
 #: a Sphinx cross-reference in a docstring, ``:func:`name` ``, shown as code
 ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
 #: the same, as the API reference renders it: the role left before the code
@@ -44,6 +48,8 @@ def on_files(files, config):
     files.append(File.generated(config, "figures.md", content=page))
     for name, path in images:
         files.append(File.generated(config, f"figures/{name}", abs_src_path=str(path)))
+    for name in SHOWN_RESULTS:
+        files.get_file_from_path(name).inclusion = InclusionLevel.INCLUDED
     return files
 
 
