@@ -179,6 +179,27 @@ def test_the_same_seed_gives_the_same_bits():
     assert not np.array_equal(first[-3], other[-3])
 
 
+def test_read_outs_by_collisions_come_at_their_marks():
+    """at_collisions reads a cooling mixture at the first read-out past each C/N mark: the
+    collision count the read-outs follow is that of run() to the same time, the temperatures
+    fall, and the same seed gives the same bits."""
+    gas = dsmc.Gas(masses=(1.0, 4.0), diameters=(1.0, 1.0), fractions=(0.5, 0.5))
+    rule = dsmc.SmoothDisks(0.8)
+    marks = np.array([0.5, 1.0, 2.0, 3.5])
+    translational, rotational = dsmc.at_collisions(gas, rule, 4000, marks, seed=4, step=0.05)
+    again = dsmc.at_collisions(gas, rule, 4000, marks, seed=4, step=0.05)
+    assert translational.shape == rotational.shape == (marks.size, 2)
+    assert np.array_equal(translational, again[0]) and np.array_equal(rotational, again[1])
+    assert np.all(np.diff(translational, axis=0) < 0) and np.all(rotational == 0.0)
+    # the gas loses a fixed share of its energy per collision per disk, T ∝ exp(−k C/N): k
+    # from the marks 0.5 apart, the last two marks (1.5 apart) show 1.5 k within the
+    # read-outs' overshoot of their marks (a step of 0.05 C/N each)
+    mixture = translational.mean(axis=1)
+    decay = mixture[-1] / mixture[-2]
+    rate = -math.log(mixture[1] / mixture[0]) / 0.5  # per C/N, from the first two marks
+    assert math.exp(-rate * 1.7) < decay < math.exp(-rate * 1.3)
+
+
 def test_a_forcing_acts_between_steps():
     """A uniform acceleration a as forcing: the total momentum grows by N m a t, and the
     temperature of the elastic gas (in the frame of the mean flow) stays where it was."""

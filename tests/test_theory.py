@@ -5,7 +5,9 @@ import pytest
 from scipy import integrate
 
 from sim.analysis.theory import (
+    enskog_collision_frequency,
     garzo_dufty_cooling_rates,
+    garzo_dufty_haff_temperature,
     garzo_dufty_temperature_ratio,
     maxwell_speed_cdf,
     maxwell_speed_pdf,
@@ -36,3 +38,16 @@ def test_garzo_dufty_heavy_species_runs_hotter_as_restitution_falls():
     gamma = ratios[2]
     z = garzo_dufty_cooling_rates([1.0, gamma], [1.0, 4.0], [0.5, 0.5], 0.8)
     assert z[0] == pytest.approx(z[1], rel=1e-10)
+
+
+def test_mixture_haff_law_of_equal_masses_is_the_one_species_law():
+    # equal masses: Haff's T₀/(1 + t/t₀)², t₀ = 4/((1 − ξ²) ω₀), ω₀ Enskog's at T₀
+    n, sigma, chi, xi, t0_temperature = 120.0, 0.01, 1.03, 0.8, 2.0
+    t = np.array([0.0, 0.3, 2.0, 9.0])
+    omega = enskog_collision_frequency(n, sigma, chi, t0_temperature, 3.0)
+    expected = t0_temperature / (1.0 + t * (1.0 - xi**2) * omega / 4.0) ** 2
+    np.testing.assert_allclose(garzo_dufty_haff_temperature(
+        t, t0_temperature, [3.0, 3.0], [0.4, 0.6], xi, n, sigma, chi), expected, rtol=1e-12)
+    # elastic: no cooling
+    np.testing.assert_allclose(garzo_dufty_haff_temperature(
+        t, 1.0, [1.0, 4.0], [0.5, 0.5], 1.0, n, sigma, chi), 1.0)

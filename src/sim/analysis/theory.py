@@ -80,6 +80,23 @@ def garzo_dufty_temperature_ratio(masses, fractions, restitution):
     return brentq(difference, 1e-3, 1e3, xtol=1e-14)
 
 
+def garzo_dufty_haff_temperature(t, temperature0, masses, fractions, restitution, n_density,
+                                 sigma, chi):
+    """Haff's law of the mixture temperature T = Σ_s x_s T_s in the homogeneous cooling state
+    of a binary mixture of equal-size disks: T(t) = T₀/(1 + ζ₀t/2)², ζ₀ the common cooling rate
+    ζ₁ = ζ₂ of :func:`garzo_dufty_cooling_rates` at T₀ and the ratio of
+    :func:`garzo_dufty_temperature_ratio`, made absolute by the factor 2√(2π) n σ χ (with it,
+    one species gives ζ = (1 − ξ²) n σ χ √(πT/m) = (1 − ξ²) ω/2, ω Enskog's collision frequency
+    :func:`enskog_collision_frequency`). Maxwellian velocity distributions; ``n_density``
+    disks per unit area, ``sigma`` the diameter; ``t`` in the units of σ√(m/T)."""
+    x = np.asarray(fractions, dtype=float) / np.sum(fractions)
+    ratio = garzo_dufty_temperature_ratio(masses, x, restitution)
+    t1 = temperature0 / (x[0] + x[1] * ratio)
+    rate = (2.0 * math.sqrt(2.0 * math.pi) * n_density * sigma * chi
+            * garzo_dufty_cooling_rates([t1, ratio * t1], masses, x, restitution)[0])
+    return temperature0 / (1.0 + 0.5 * rate * np.asarray(t)) ** 2
+
+
 def rough_disk_cooling_coefficients(xi, beta, q):
     """(A, B, C) of the cooling of a dilute gas of equal rough disks (normal restitution ξ,
     tangential restitution β, I = q m a²; :mod:`sim.effects.rotation`) in the two-temperature

@@ -322,6 +322,35 @@ def run(gas, rule, n_particles, times, seed, forcing=None, step_fraction=STEP_FR
     return simulate(gas, rule, state, times, rng, forcing, step_fraction)
 
 
+def at_collisions(gas, rule, n_particles, marks, seed, step=0.05, **initial):
+    """(T_tr, T_rot) per species, float64[K, S] each, at each of the K collisions per particle
+    C/N of ``marks`` (increasing, ≥ 0): a time series by the engine's clock of collisions, for
+    a gas whose collision rate changes as it cools. Read out about every ``step`` C/N (each
+    chunk of time from the collision rate of the one before) and interpolated linearly in C/N
+    between the read-outs on either side of a mark (an error of order (k step)² for a gas
+    whose temperatures change as exp(−k C/N)). The start as :func:`run`'s (``initial``,
+    ``seed``)."""
+    rng = np.random.default_rng(seed)
+    state = initial_state(gas, n_particles, rng, **initial)
+    frequency = enskog_collision_frequency(gas.density, max(gas.diameters), gas.chi, 1.0,
+                                           min(gas.masses))  # a first guess; then measured
+    done, now = 0.0, np.array(temperatures(gas, state))
+    read = []
+    for mark in marks:
+        while done < mark:
+            dt = 2.0 * step / frequency
+            series, state = simulate(gas, rule, state, [dt], rng)
+            added = series.collisions_per_particle[0]
+            frequency = max(2.0 * added / dt, 1e-300)
+            before, now = now, np.array(temperatures(gas, state))
+            done += added
+        if done > mark:  # between the last two read-outs
+            read.append(before + (mark - done + added) / added * (now - before))
+        else:
+            read.append(now)
+    return np.array([r[0] for r in read]), np.array([r[1] for r in read])
+
+
 class CoolingState(NamedTuple):
     """The homogeneous cooling state: r = T_rot/T_tr and ζ/ν (ν Enskog's at T_tr), each
     with its standard error; ``collisions_per_particle`` C/N simulated over all seeds."""

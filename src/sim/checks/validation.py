@@ -19,13 +19,13 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import brentq
 
-from sim.analysis.datasets import granular_temperatures
 from sim.analysis.theory import (
     enskog_collision_frequency,
     garzo_dufty_temperature_ratio,
     henderson_z,
     kolafa_rottner_z,
 )
+from sim.checks import dsmc
 from sim.checks.rough import rough_cooling, rough_equipartition
 from sim.checks.rows import Check, block_means
 from sim.engine.core import Engine
@@ -146,26 +146,26 @@ def cooling_gas(n, phi, restitution, seed, tc=None, mass=1.0, species=None):
     return engine, radius
 
 
-def haff_cooling(restitution, n=4000, phi=0.1, seed=5, runs=8, longest=60.0):
-    """Homogeneous cooling: E(C)/E₀ against exp(−(1 − ξ²) C/N) at C/N = 1/(1 − ξ²) (E/E₀ = 1/e),
-    and T(t)/T₀ against Haff's 1/(1 + t/t₀)², t₀ = 4/((1 − ξ²) ω₀) with Enskog's ω₀ (χ from
-    Kolafa–Rottner), at t = t₀ (T/T₀ = 1/4), each the mean over ``runs`` realizations (seeds
-    ``seed``, ``seed + 1``, …). Then every run goes on, up to C/N = ``longest``, to find where
-    E(C) first departs by more than 5 % from the exponential (the median over runs).
+def haff_cooling(restitution, n=2000, phi=0.005, seed=5, runs=32, dsmc_particles=10000,
+                 dsmc_runs=8):
+    """Homogeneous cooling of smooth disks: E(C)/E₀ at C/N = 1/(1 − ξ²) and T(t₀)/T₀ at
+    t₀ = 4/((1 − ξ²) ω₀) (ω₀ Enskog's collision frequency at T₀, χ from Kolafa–Rottner), each
+    the mean of ``runs`` runs (seeds ``seed``, ``seed + 1``, …) from the equilibrated elastic
+    gas, against DSMC of the same Boltzmann–Enskog equation from a Maxwellian start
+    (:mod:`sim.checks.dsmc`, ``dsmc_runs`` runs of ``dsmc_particles``). Haff's law, which
+    takes the distribution as Maxwellian, is named beside them: E/E₀ = exp(−(1 − ξ²) C/N) =
+    1/e and T/T₀ = 1/(1 + t/t₀)² = 1/4 (the Sonine correction a₂ is below 1 % for ξ ≥ 0.7).
 
-    Tolerances: 3 % on E(C) and 5 % on T(t₀). The Sonine correction a₂ is below 1 % for
-    ξ ≥ 0.7, but the early growth of the instability already slows the cooling, and Enskog's
-    rate with the equilibrium χ sets t₀: over 20 runs of 4000 disks (seeds 200 … 219) E(C)
-    lay 1.3 % (ξ = 0.9) and 1.9 % (ξ = 0.8) above exp(−1), T(t₀) 1.9 % and 3.3 % above 1/4,
-    with standard deviations of 0.8–1.2 % from run to run: 0.3–0.4 % for a mean of 8. The
-    departure is the clustering instability of a box larger than 2√π/(nσ√(1 − ξ²)): dense
-    clusters collide less often per unit energy lost than the homogeneous gas, so the cooling
-    slows.
+    The box is below the length at which a cooling gas grows shear and clusters,
+    2√π/(nσ√(1 − ξ²)) (N φ = 10: 2.3 box sides at ξ = 0.9, 1.7 at ξ = 0.8), so that the gas
+    stays homogeneous (a larger box cools more slowly once its clusters grow, and the
+    Boltzmann equation of a homogeneous gas no longer describes it). Tolerances: four standard
+    errors of the difference (the runs' and DSMC's, in quadrature).
     """
     started = time.perf_counter()
     rate = 1.0 - restitution**2
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
-    energy_at_c, temperature_at_t0, departure = [], [], []
+    energy_at_c, temperature_at_t0 = [], []
     for realization in range(runs):
         engine, radius = cooling_gas(n, phi, restitution, seed + realization)
         e0 = engine.kinetic_energy()
@@ -174,99 +174,129 @@ def haff_cooling(restitution, n=4000, phi=0.1, seed=5, runs=8, longest=60.0):
         energy_at_c.append(engine.kinetic_energy() / e0)
         engine.run(time=t0)
         temperature_at_t0.append(engine.kinetic_energy() / e0)
-        departure.append(math.inf)
-        for c_per_n in np.arange(math.ceil(engine.collisions / n), longest + 1.0):
-            engine.run(collisions=round(c_per_n * n))
-            if engine.kinetic_energy() / e0 > 1.05 * math.exp(-rate * engine.collisions / n):
-                departure[-1] = engine.collisions / n
-                break
+    gas = dsmc.Gas(diameters=(2.0 * radius,), density=float(n), chi=chi)
+    rule = dsmc.SmoothDisks(restitution)
+    exact_energy, exact_temperature = [], []
+    for k in range(dsmc_runs):
+        translational, _ = dsmc.at_collisions(gas, rule, dsmc_particles, [0.0, 1.0 / rate],
+                                              seed + k)
+        exact_energy.append(translational[1, 0] / translational[0, 0])
+        rng = np.random.default_rng(seed + k)
+        state = dsmc.initial_state(gas, dsmc_particles, rng)
+        t_zero = dsmc.temperatures(gas, state)[0][0]
+        t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, t_zero))
+        series, _ = dsmc.simulate(gas, rule, state, [t0], rng)
+        exact_temperature.append(series.translational[0, 0] / t_zero)
     seconds = time.perf_counter() - started
-    box_limit = 2.0 * math.sqrt(math.pi) / (n * 2.0 * radius * math.sqrt(rate))
-    median_departure = float(np.median(departure))
-    where = (f"beyond C/N = {longest:.0f}" if math.isinf(median_departure)
-             else f"at C/N = {median_departure:.0f}")
-    return [
-        Check(f"Haff E(C)/E₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, φ = {phi}, "
-              f"mean of {runs} runs", float(np.mean(energy_at_c)), math.exp(-1.0),
-              0.03 * math.exp(-1.0),
-              f"exp(−(1−ξ²)C/N); departs by 5 % {where} (median), box 1 > instability length "
-              f"{box_limit:.2f}", seconds),
-        Check(f"Haff T(t₀)/T₀, ξ = {restitution}", float(np.mean(temperature_at_t0)), 0.25,
-              0.05 * 0.25, "T₀/(1 + t/t₀)², Enskog ω₀", None),
-    ]
+    rows = []
+    for name, measured, exact, haff, source in (
+            (f"Haff E(C)/E₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, N = {n}, φ = {phi}, "
+             f"mean of {runs} runs", energy_at_c, exact_energy, math.exp(-1.0),
+             "exp(−(1−ξ²)C/N)"),
+            (f"Haff T(t₀)/T₀, ξ = {restitution}", temperature_at_t0, exact_temperature, 0.25,
+             "T₀/(1 + t/t₀)², Enskog ω₀")):
+        value, error = block_means(measured)
+        reference, reference_error = block_means(exact)
+        rows.append(Check(name, value, reference, 4.0 * math.hypot(error, reference_error),
+                          f"DSMC, {dsmc_runs} runs of {dsmc_particles} (± "
+                          f"{reference_error:.2g}); Haff's law {source}: {haff:.4f}",
+                          seconds if not rows else None))
+    return rows
 
 
-def mixture_temperature_ratio(restitution, n=4000, phi=0.1, mass_ratio=4.0, seed=7, runs=4):
+def mixture_temperature_ratio(restitution, n=800, phi=0.02, mass_ratio=4.0, seed=7, runs=32,
+                              window=(5, 30), dsmc_particles=10000, dsmc_runs=8):
     """T₂/T₁ of an equimolar mixture of equal-size disks with m₂/m₁ = ``mass_ratio``, against
-    equipartition (ξ = 1) or the homogeneous cooling state of Garzó & Dufty (ξ < 1).
+    equipartition (ξ = 1, exact) or, at ξ < 1, the homogeneous cooling state of the Boltzmann–
+    Enskog equation solved by DSMC (:func:`sim.checks.dsmc.at_collisions`, the same masses,
+    fractions and Maxwellian start, read at the same collisions per disk), with the Maxwellian
+    theory of Garzó & Dufty (1999) named beside it.
 
-    Temperatures are taken in the frame of the local flow (:func:`sim.analysis.datasets.
-    granular_temperatures`) and averaged over C/N = 2 … 8: after the start's transient, before
-    the clustering instability has grown. The snapshots of one run are correlated over a few
-    collisions per disk, so the error comes from ``runs`` independent runs (seeds ``seed``,
-    ``seed + 1``, …), each averaged over its snapshots. Tolerance: four standard errors of
-    the mean of the runs, plus 3 % for the theory at ξ < 1 (molecular dynamics agrees within
-    a few percent at low φ). At ξ = 1 a second row tests the energies m v²/2 of both species
-    together against the exponential law with mean T (KS p-value above 0.01), which holds for
-    any mass.
+    The gas is that of figure 7: N φ = 16 puts the box below the length at which a cooling
+    gas grows shear and clusters (1.31 box sides at ξ = 0.8), so it stays homogeneous and the
+    species temperatures are T_s = E_s/N_s (zero total momentum). A larger box does not: at
+    N = 4000, φ = 0.1 (four such lengths) the ratio over C/N = 2 … 8 read 1.356 ± 0.008 in
+    the frame of the local flow against DSMC's 1.306 ± 0.002 over the same window. The ratio
+    is averaged over the snapshots at C/N = ``window[0]`` … ``window[1]``, one per collision
+    per disk; they are correlated within a run, so the error comes from ``runs`` independent
+    runs (seeds ``seed``, ``seed + 1``, …), each averaged over its snapshots, and DSMC's from
+    its ``dsmc_runs`` runs. Tolerance: four standard errors (both added in quadrature). At
+    ξ = 1 a second row tests the energies m v²/2 of both species together against the
+    exponential law with mean T (KS p-value above 0.01), which holds for any mass.
     """
     started = time.perf_counter()
     species = np.arange(n) % 2
     mass = np.where(species == 1, mass_ratio, 1.0)
+    marks = np.arange(window[0], window[1] + 1)
     run_ratios, energies = [], []
     for run in range(runs):
         engine, _ = cooling_gas(n, phi, None if restitution == 1.0 else restitution,
                                 seed + run, mass=mass, species=species)
-        ratios = []
-        for c_per_n in range(2, 9):
-            engine.run(collisions=c_per_n * n)
-            temperatures = granular_temperatures(engine.positions()[None],
-                                                 engine.velocities()[None], mass, species,
-                                                 engine.box)[0]
-            ratios.append(temperatures[1] / temperatures[0])
-            if run == 0:
-                energies.append(0.5 * mass * np.sum(engine.velocities() ** 2, axis=1))
-        run_ratios.append(np.mean(ratios))
-        if run == 0:
-            temperature = engine.kinetic_energy() / (n - 1)
+        temperatures = []
+        for c_per_n in marks:
+            engine.run(collisions=int(c_per_n * n))
+            energy = 0.5 * mass * np.sum(engine.velocities() ** 2, axis=1)
+            temperatures.append(np.bincount(species, weights=energy) / np.bincount(species))
+            energies.append(energy)
+        temperatures = np.array(temperatures)
+        run_ratios.append(np.mean(temperatures[:, 1] / temperatures[:, 0]))
     ratio, error = block_means(run_ratios)
-    seconds = time.perf_counter() - started
-    reference = garzo_dufty_temperature_ratio([1.0, mass_ratio], [0.5, 0.5], restitution)
-    theory_margin = 0.0 if restitution == 1.0 else 0.03 * reference
-    rows = [Check(f"mixture T₂/T₁, m₂/m₁ = {mass_ratio:g}, ξ = {restitution}, mean of {runs} "
-                  f"runs", ratio, reference, 4.0 * error + theory_margin,
-                  "equipartition" if restitution == 1.0 else "Garzó & Dufty 1999", seconds)]
+    theory = garzo_dufty_temperature_ratio([1.0, mass_ratio], [0.5, 0.5], restitution)
     if restitution == 1.0:
-        p_value = stats.kstest(np.concatenate(energies),
+        reference, reference_error, source = 1.0, 0.0, "equipartition"
+    else:
+        radius = radius_for_packing(n, phi)
+        gas = dsmc.Gas(masses=(1.0, mass_ratio), diameters=(2.0 * radius,) * 2,
+                       fractions=(0.5, 0.5), density=float(n),
+                       chi=(kolafa_rottner_z(phi) - 1.0) / (2.0 * phi))
+        exact = [dsmc.at_collisions(gas, dsmc.SmoothDisks(restitution), dsmc_particles, marks,
+                                    seed + k)[0] for k in range(dsmc_runs)]
+        reference, reference_error = block_means([np.mean(t[:, 1] / t[:, 0]) for t in exact])
+        source = (f"DSMC, {dsmc_runs} runs of {dsmc_particles} (± {reference_error:.2g}); "
+                  f"Garzó & Dufty 1999, Maxwellian: {theory:.4f}")
+    seconds = time.perf_counter() - started
+    rows = [Check(f"mixture T₂/T₁, m₂/m₁ = {mass_ratio:g}, ξ = {restitution}, N = {n}, "
+                  f"φ = {phi}, C/N = {window[0]} … {window[1]}, mean of {runs} runs", ratio,
+                  reference, 4.0 * math.hypot(error, reference_error), source, seconds)]
+    if restitution == 1.0:
+        temperature = float(np.mean(np.concatenate(energies)))
+        p_value = stats.kstest(np.concatenate(energies[::len(marks)]),
                                stats.expon(scale=temperature).cdf).pvalue
         rows.append(Check("KS p-value, energies m v²/2 of both masses", p_value, 1.0, 0.99,
                           "exponential with mean T, any mass", None))
     return rows
 
 
-def tc_model(restitution=0.8, n=4000, phi=0.1, seed=5):
+def tc_model(restitution=0.8, n=4000, phi=0.1, seed=5, runs=8):
     """The TC model with t_c = 10⁻⁴ mean free times leaves the cooling unchanged: E(C)/E₀ at
-    C/N = 1/(1 − ξ²) with and without it agree within 1 %; and the energy the engine booked as
-    dissipated equals the kinetic energy lost, to round-off (1e-12 relative)."""
+    C/N = 1/(1 − ξ²) with it over E(C)/E₀ without it, run by run from the same start (seeds
+    ``seed``, ``seed + 1``, …), is 1 within four standard errors of the mean of ``runs`` runs
+    (the two runs of a pair part as their paths diverge, so their ratio scatters); and the
+    energy the engine booked as dissipated equals the kinetic energy lost, to round-off (1e-12
+    relative)."""
     started = time.perf_counter()
     rate = 1.0 - restitution**2
-    plain, radius = cooling_gas(n, phi, restitution, seed)
-    chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
-    mean_free_time = 1.0 / enskog_collision_frequency(n, 2.0 * radius, chi, 1.0)
-    with_tc, _ = cooling_gas(n, phi, restitution, seed, tc=1e-4 * mean_free_time)
-    results = []
-    for engine in (plain, with_tc):
-        e0 = engine.kinetic_energy()
-        engine.run(collisions=round(n / rate))
-        results.append((engine.kinetic_energy() / e0, e0 - engine.kinetic_energy(),
-                        engine.dissipated_energy))
+    ratios, worst = [], 0.0
+    for run in range(runs):
+        plain, radius = cooling_gas(n, phi, restitution, seed + run)
+        chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
+        mean_free_time = 1.0 / enskog_collision_frequency(n, 2.0 * radius, chi, 1.0)
+        with_tc, _ = cooling_gas(n, phi, restitution, seed + run, tc=1e-4 * mean_free_time)
+        cooled = []
+        for engine in (plain, with_tc):
+            e0 = engine.kinetic_energy()
+            engine.run(collisions=round(n / rate))
+            cooled.append(engine.kinetic_energy() / e0)
+        ratios.append(cooled[1] / cooled[0])
+        lost = e0 - with_tc.kinetic_energy()
+        worst = max(worst, abs(with_tc.dissipated_energy / lost - 1.0))
+    ratio, error = block_means(ratios)
     seconds = time.perf_counter() - started
-    (plain_ratio, _, _), (tc_ratio, lost, booked) = results
     return [
-        Check("TC (t_c = 1e-4 mean free times): E(C)/E₀ with / without", tc_ratio / plain_ratio,
-              1.0, 0.01, "unchanged cooling (Luding & McNamara 1998)", seconds),
-        Check("dissipated energy booked / kinetic energy lost", booked / lost, 1.0, 1e-12,
-              "exact bookkeeping", None),
+        Check(f"TC (t_c = 1e-4 mean free times): E(C)/E₀ with / without, mean of {runs} runs",
+              ratio, 1.0, 4.0 * error, "unchanged cooling (Luding & McNamara 1998)", seconds),
+        Check("dissipated energy booked / kinetic energy lost − 1, worst of the runs", worst,
+              0.0, 1e-12, "exact bookkeeping", None),
     ]
 
 
@@ -377,7 +407,8 @@ def thermal_walls(n=1000, phi=0.02, temperature=2.0, samples=400, seed=3):
     """Elastic disks between four walls at T_w come to equilibrium at T_w: the time average of
     E_kin/N is T_w, and the energies m v²/2 are exponential with mean T_w (a KS test on
     thinned samples). The total energy fluctuates by about 1/√N and relaxes only through the
-    walls, so the average runs over ``samples`` snapshots 0.1 apart in time."""
+    walls, so the average runs over ``samples`` snapshots 0.1 apart in time; its error is that
+    of the means of ten consecutive blocks of them, and the tolerance four of it."""
     started = time.perf_counter()
     radius = radius_for_packing(n, phi)
     walls = {name: {"temperature": temperature} for name in ("left", "right", "bottom", "top")}
@@ -389,11 +420,13 @@ def thermal_walls(n=1000, phi=0.02, temperature=2.0, samples=400, seed=3):
     for k in range(1, samples + 1):
         engine.run(time=start + 0.1 * k)
         energies.append(0.5 * np.sum(engine.velocities(start + 0.1 * k) ** 2, axis=1))
+    mean, error = block_means([np.mean(block) / temperature
+                               for block in np.array_split(np.array(energies), 10)])
     energies = np.concatenate(energies)
     seconds = time.perf_counter() - started
     return [
-        Check(f"thermal walls: ⟨m v²/2⟩ / T_w, T_w = {temperature}",
-              energies.mean() / temperature, 1.0, 0.02, "equilibrium with the walls", seconds),
+        Check(f"thermal walls: ⟨m v²/2⟩ / T_w, T_w = {temperature}", mean, 1.0, 4.0 * error,
+              "equilibrium with the walls", seconds),
         Check("KS p-value of energies m v²/2 against exp(mean T_w)",
               stats.kstest(energies[np.arange(samples) * n + np.arange(samples) * 7919 % n],
                            "expon", args=(0.0, temperature)).pvalue, 1.0,
