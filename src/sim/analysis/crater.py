@@ -126,9 +126,10 @@ def crater_overrides(quick):
 
 def require_stop(sweep, swept, reason, remedy):
     """Raise when a run of ``sweep`` (over the dimension ``swept``) stopped otherwise than by
-    ``reason``: its crater would be read at another stage than the others'."""
-    values = sweep[swept].values
-    unfinished = values[sweep["stop_reason"].values != reason]
+    ``reason``: its crater would be read at another stage than the others' (over the other
+    swept dimensions, such as seeds, any run)."""
+    stopped = sweep["stop_reason"] != reason
+    unfinished = sweep[swept].values[stopped.any([d for d in stopped.dims if d != swept]).values]
     if unfinished.size:
         raise ValueError(f"runs at {swept} = {unfinished.tolist()} stopped otherwise than by "
                          f"{reason}: {remedy}")

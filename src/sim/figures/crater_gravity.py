@@ -13,18 +13,22 @@ calibrated on the settled bed under that surface (:func:`sim.analysis.crater.cal
 the cavity is the area under the surface that no disk (projectile included) overlaps, less
 that area before impact, and its largest value over the snapshots is the crater. The impact
 energy is the projectile's kinetic energy when it reaches the surface,
-E = m v₀²/2 + m g (y₀ − R − surface). A power law A ∝ E^β is fitted in log–log over the
-runs whose cavity covers at least one grid cell, and again over those whose cavity is larger
-than the projectile's own area πR² (smaller ones are shaped by the projectile's size and the
-grid more than by the energy). In 2D the gravity regime with energy scaling
-(the cavity's mass lifted by its own depth, E ~ ρ g R³) gives β = 2/3 (docs/physics.md,
-"Cratering"); momentum scaling gives smaller exponents.
+E = m v₀²/2 + m g (y₀ − R − surface). Each speed runs on ``seeds`` beds (each seed settles
+its own); the figure gives the mean largest cavity over the beds with its standard error.
+
+The points curve in log–log (cavities near the projectile's own area πR² are shaped by its size
+and the grid more than by the energy, the largest ones feel the box), so no single power law
+is fitted: the middle panel gives the local exponent d ln A / d ln E between neighbouring
+energies (the standard errors of the two means in quadrature; the beds of one seed are the
+same at every speed, so neighbouring energies are not independent and that error is an
+estimate), beside β = 2/3 of the 2D gravity
+regime with energy scaling (the cavity's mass lifted by its own depth, E ~ ρ g R³;
+docs/physics.md, "Cratering"; momentum scaling gives smaller exponents).
 """
 
 import numpy as np
 import yaml
 from matplotlib.ticker import NullFormatter
-from scipy import stats
 
 from sim.analysis.crater import calibrated_spacing, crater_area, preparation_of, require_stop
 from sim.analysis.datasets import open_sweep
@@ -38,10 +42,15 @@ def speeds(quick):
     return (1.0, 2.0, 4.0, 8.0) if quick else (1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0)
 
 
+def seeds(quick):
+    return 2 if quick else 5
+
+
 def sweeps(quick):
     bed = ["bed.n=600", "bed.radius=0.011"] if quick else []
     return {"energy": ["scenario=crater_gravity", *bed,
-                       "projectile.speed=" + ",".join(map(str, speeds(quick)))]}
+                       "projectile.speed=" + ",".join(map(str, speeds(quick))),
+                       f"seed=range(0,{seeds(quick)})"]}
 
 
 def cavity_of_run(run):
@@ -68,43 +77,54 @@ def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["energy"])
     speed = ds["projectile_speed"].values
     require_stop(ds, "projectile_speed", "at_rest", "raise their stop.time")
-    cavities = [cavity_of_run(ds.isel(projectile_speed=k)) for k in range(speed.size)]
-    energy = np.array([c[0] for c in cavities])
-    area = np.array([c[1].max() for c in cavities])
-    final = np.array([c[1][-1] for c in cavities])
-    opened = area > 0.0  # a cavity below one grid cell is not resolved
-    fit = stats.linregress(np.log(energy[opened]), np.log(area[opened]))
-    projectile_area = np.pi * float(ds["radius"].values[-1]) ** 2
-    large = area > projectile_area
-    large_fit = stats.linregress(np.log(energy[large]), np.log(area[large]))
-    fig, (left, right) = figure(width=10)
+    beds = ds.sizes["seed"]
+    cavities = [[cavity_of_run(ds.isel(projectile_speed=k, seed=j)) for j in range(beds)]
+                for k in range(speed.size)]
+    energy = np.array([[c[0] for c in row] for row in cavities])  # [speed, bed]
+    largest = np.array([[c[1].max() for c in row] for row in cavities])
+    final = np.array([[c[1][-1] for c in row] for row in cavities])
+    mean_energy = energy.mean(axis=1)
+    area, area_error = largest.mean(axis=1), largest.std(axis=1, ddof=1) / np.sqrt(beds)
+    final_area = final.mean(axis=1)
+    # d ln A / d ln E between neighbouring energies, at their geometric midpoints
+    step = np.log(mean_energy[1:] / mean_energy[:-1])
+    relative = area_error / area
+    local = np.log(area[1:] / area[:-1]) / step
+    local_error = np.hypot(relative[1:], relative[:-1]) / step
+    projectile_area = np.pi * float(ds["radius"].values.flat[-1]) ** 2
+    fig, (left, middle, right) = figure(ncols=3, width=14)
     fig.suptitle(preparation_of(ds), fontsize=9)
-    curve = np.geomspace(energy.min(), energy.max(), 100)
-    left.loglog(energy[opened], area[opened], "o", color="C0", label="largest cavity")
-    left.loglog(curve, np.exp(fit.intercept) * curve**fit.slope, "-", color="C0", lw=1,
-                label=f"fit A ∝ E^{fit.slope:.2f} (β = {fit.slope:.2f} ± {fit.stderr:.2f})")
-    left.loglog(energy[large], np.exp(large_fit.intercept) * energy[large] ** large_fit.slope,
-                "--", color="C3", lw=1, label=f"fit over A > πR²: β = {large_fit.slope:.2f} ± "
-                                             f"{large_fit.stderr:.2f}")
-    middle = (np.exp(np.mean(np.log(area[opened])))
-              * (curve / np.exp(np.mean(np.log(energy[opened])))) ** (2 / 3))
-    left.loglog(curve, middle, "k:", lw=1, label="β = 2/3 (2D gravity, energy scaling)")
-    left.set(xlabel="impact energy E (bed-disk mass × g × box length)",
+    left.errorbar(mean_energy, area, yerr=area_error, fmt="s", color="C0", capsize=3,
+                  label=f"largest cavity, mean of {beds} beds ± standard error")
+    left.axhline(projectile_area, color="k", ls=":", lw=1, label="πR², the projectile's area")
+    left.set(xscale="log", yscale="log",
+             xlabel="impact energy E (bed-disk mass × g × box length)",
              ylabel="crater area A (box units²)", title="transient crater under gravity")
     left.legend(fontsize=8)
+    middle.errorbar(np.sqrt(mean_energy[1:] * mean_energy[:-1]), local, yerr=local_error,
+                    fmt="o-", color="C1", capsize=3, label="between neighbouring energies")
+    middle.axhline(2.0 / 3.0, color="k", ls=":", lw=1, label="2/3: 2D gravity, energy scaling")
+    middle.set(xscale="log", xlabel="impact energy E", ylabel="local exponent d ln A / d ln E",
+               title="the slope of the left panel")
+    middle.legend(fontsize=8)
     ticks = [e for e in (20, 50, 100, 200, 500, 1000, 2000, 5000, 10000)
-             if energy[opened].min() / 1.5 <= e <= 1.5 * energy[opened].max()]
-    left.set_xticks(ticks, labels=[f"{e:g}" for e in ticks])
-    left.xaxis.set_minor_formatter(NullFormatter())
-    for k, (_, cavity, time, _) in enumerate(cavities):
+             if mean_energy.min() / 1.5 <= e <= 1.5 * mean_energy.max()]
+    for axis in (left, middle):
+        axis.set_xticks(ticks, labels=[f"{e:g}" for e in ticks])
+        axis.xaxis.set_minor_formatter(NullFormatter())
+    for k in range(speed.size):
+        _, cavity, time, _ = cavities[k][0]
         right.plot(time, cavity, color=f"C{k}", lw=1, label=f"v₀ = {speed[k]:g}")
-    right.set(xlabel="time (√(L/g))", ylabel="empty area under the surface (box units²)",
-              title=f"the cavity opens and closes (Δx = {cavities[0][3]:.3g})")
+    right.set(xlabel="time  [√(L/g)]", ylabel="empty area under the surface (box units²)",
+              title=f"it opens and closes (bed 0, Δx = {cavities[0][0][3]:.3g})")
     right.legend(fontsize=7)
-    np.savetxt(out_dir / f"{NAME}.csv", np.column_stack([speed, energy, area, final]),
+    np.savetxt(out_dir / f"{NAME}.csv",
+               np.column_stack([speed, mean_energy, area, area_error, final_area,
+                                np.full(speed.size, beds), np.append(local, np.nan),
+                                np.append(local_error, np.nan)]),
                delimiter=",", fmt="%.6g",
-               header=f"projectile_speed,impact_energy,largest_cavity_area,final_cavity_area  "
-                      f"(fit: exponent {fit.slope:.4f} +- {fit.stderr:.4f}; over cavities "
-                      f"larger than the projectile: {large_fit.slope:.4f} +- "
-                      f"{large_fit.stderr:.4f}; dx {cavities[0][3]:.6g})", comments="")
+               header=f"projectile_speed,impact_energy,largest_cavity_area,its_error,"
+                      f"final_cavity_area,beds,local_exponent_to_next,its_error  (means over "
+                      f"the beds; no power law fitted: the local exponent is not constant; "
+                      f"projectile area {projectile_area:.6g})", comments="")
     return save(fig, out_dir, NAME)

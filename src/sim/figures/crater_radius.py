@@ -7,25 +7,22 @@ calibrated on its own untouched bed.
 Floor-limited runs: a projectile whose lowest point comes within ``FLOOR_GAP`` bed-disk
 diameters of the floor before the stop (seen at the snapshots, every 20 000 collisions, in
 which it moves a small fraction of its radius) has dug through the bed; its crater is set
-by the box, not by the impact. Those runs are drawn as open symbols and left out of the fit (and
+by the box, not by the impact. Those runs are drawn as open symbols and left out of the means (and
 may stop by their collision budget instead, bouncing on the floor).
 
-The fit: log A = log c + α log R + ε over every run that is not floor-limited, ε with one
-variance for all (least squares in log–log, scipy.stats.linregress), α with its standard
-error. The beds of one seed are the same at every radius, so runs at different radii are
-not independent and that error is a lower bound. What the data show is not one power law:
-the local exponent d ln A / d ln R between neighbouring radii (right panel, over the beds
-not floor-limited) falls as R grows, from above 2 for projectiles a few bed disks wide to
-near 1 for larger ones, before any reaches the floor. The fitted α is an average over the
+What the data show is not one power law, so none is fitted: the local exponent
+d ln A / d ln R between neighbouring radii (right panel, over the beds not floor-limited) falls
+as R grows, from above 2 for projectiles a few bed disks wide to near 1 for larger ones, before
+any reaches the floor. A single exponent through these points would be an average over the
 range, not a scaling law; geometric similarity (α = 2, area ∝ mass) would need grains much
-smaller than the projectile and a bed much deeper than the crater. The numbers file gives,
-per radius, the mean area over the beds not floor-limited, its standard error, the number
-of floor-limited beds, the local exponent to the next radius, and the fit.
+smaller than the projectile and a bed much deeper than the crater. The beds of one seed are the
+same at every radius, so neighbouring radii are not independent, and the errors of the local
+exponent (the standard errors of the two means, added in quadrature) are an estimate. The
+numbers file gives, per radius, the mean area over the beds not floor-limited, its standard
+error, the number of floor-limited beds, and the local exponent to the next radius.
 """
 
 import numpy as np
-from scipy import stats
-
 from sim.analysis.crater import CraterGeometry, crater_overrides, preparation_of
 from sim.analysis.datasets import at_last_snapshot, open_sweep
 from sim.figures.style import figure, save
@@ -80,7 +77,6 @@ def draw(runs, sweeps, out_dir):
         mass = mass[:, 0]
     free = ~floor
     radius_of_run = np.broadcast_to(radius[:, None], area.shape)
-    fit = stats.linregress(np.log(radius_of_run[free]), np.log(area[free]))
     beds = free.sum(axis=1)  # beds not floor-limited, per radius
     mean = np.array([area[i, free[i]].mean() if beds[i] else np.nan for i in range(radius.size)])
     error = np.array([area[i, free[i]].std(ddof=1) / np.sqrt(beds[i]) if beds[i] > 1 else np.nan
@@ -91,15 +87,13 @@ def draw(runs, sweeps, out_dir):
     relative = error / mean
     local_error = np.hypot(relative[1:], relative[:-1]) / step
     fig, (left, right) = figure(width=10)
-    curve = np.geomspace(radius[beds > 0].min(), radius[beds > 0].max(), 100)
+    curve = np.geomspace(radius.min(), radius.max(), 100)
     left.loglog(radius_of_run[free], area[free], "o", color="C0", ms=3, alpha=0.4, label="one bed")
     left.errorbar(radius, mean, yerr=error, fmt="s", color="C0", ms=5, capsize=3,
                   label="mean of the beds ± standard error")
     if floor.any():
         left.loglog(radius_of_run[floor], area[floor], "o", mfc="none", color="C3", ms=5,
-                    label="floor-limited (not fitted)")
-    left.loglog(curve, np.exp(fit.intercept) * curve**fit.slope, "-", color="C0", lw=1,
-                label=f"fit A = c R^α: α = {fit.slope:.2f} ± {fit.stderr:.2f}")
+                    label="floor-limited (left out of the means)")
     left.loglog(curve, np.pi * curve**2, "k:", lw=1, label="πR² (the projectile's own area)")
     left.set(xlabel="projectile radius R (box units)", ylabel="crater area A (box units²)",
              title=f"area at 10 % energy left, {seed.size} beds per radius")
@@ -113,9 +107,9 @@ def draw(runs, sweeps, out_dir):
     right.legend(fontsize=8)
     fig.suptitle(preparation_of(ds), fontsize=9)
     header = (f"projectile_radius,projectile_mass,crater_area_mean,crater_area_error,"
-              f"floor_limited_beds,local_exponent_to_next,its_error  (means over the beds not "
-              f"floor-limited; fit over those {int(free.sum())} runs: exponent "
-              f"{fit.slope:.4f} +- {fit.stderr:.4f}, prefactor {np.exp(fit.intercept):.4g})")
+              f"floor_limited_beds,local_exponent_to_next,its_error  (means over the "
+              f"{int(free.sum())} beds not floor-limited of {free.size}; no power law fitted: "
+              f"the local exponent is not constant)")
     np.savetxt(out_dir / f"{NAME}.csv",
                np.column_stack([radius, mass, mean, error, floor.sum(axis=1),
                                 np.append(local, np.nan), np.append(local_error, np.nan)]),

@@ -8,29 +8,50 @@ which a cooling gas grows shear and clusters, L_c = 2√π / (n σ √(1 − ξ�
 density, σ the diameter), by the choice of N φ: with φ fixed, n σ grows as √(N φ), and
 N φ = 16 puts L_c at 1.31 box sides for the smallest ξ = 0.8 (more for ξ = 0.9), so the gas
 stays homogeneous at every stage and the species temperatures are the kinetic energies per
-disk (2D, k_B = 1: T_s = E_s/N_s), no flow to subtract. The ratio leaves T₂/T₁ = 1 in the
-first few collisions per disk; the window from ``WINDOW[0]`` collisions per disk on is the
-homogeneous cooling state. The ratio is that of the species temperatures averaged over the
-independent runs (seeds), at each snapshot, then over the window; its error is the
-jackknife standard error over the runs (:func:`ratio_over_runs`). The theory takes both
-velocity distributions as Maxwellian (the leading Sonine order) and the Enskog collision
-rate, which cancels for equal sizes; this figure measures how close that approximation
-comes. L_c is the estimate of a gas of one mass, with the elastic gas's viscosity, applied
-to the mixture; the margin of 31 % covers that.
+disk (2D, k_B = 1: T_s = E_s/N_s), no flow to subtract.
+
+The window rule: the ratio leaves T₂/T₁ = 1 within the first few collisions per disk (C/N)
+and the homogeneous cooling state is averaged over C/N from ``WINDOW[0]`` to the end of the
+runs, ``WINDOW[1]``. The right panel shows the window's effect: the mean from each start in
+``STARTS`` to the end, with its error. The ratio is that of the species temperatures averaged
+over the independent runs (seeds), at each snapshot, then over the window; its error is the
+jackknife standard error over the runs (:func:`ratio_over_runs`).
+
+Two references. Garzó & Dufty take both velocity distributions as Maxwellian (the leading
+Sonine order) and the Enskog collision rate, which cancels in the ratio for equal sizes; DSMC
+solves the same Boltzmann–Enskog equation without that approximation
+(:mod:`sim.checks.dsmc`, same masses, fractions, n, σ, χ and Maxwellian start, read out at
+the runs' mean times, ``DSMC_DISKS`` particles, ``DSMC_SEEDS`` runs). The left panel gives the
+mixture temperature T = (T₁ + T₂)/2 against time, beside DSMC's and Haff's law with the
+Garzó–Dufty cooling rate from the window's first snapshot
+(:func:`sim.analysis.theory.garzo_dufty_haff_temperature`). Time is in units of L√(m₁/T₀)
+(box side L, the lighter mass m₁, initial temperature T₀), averaged over the runs. L_c is the
+estimate of a gas of one mass, with the elastic gas's viscosity, applied to the mixture; the
+margin of 31 % covers that.
 """
 
 import numpy as np
 
 from sim.analysis.datasets import open_sweep
-from sim.analysis.theory import garzo_dufty_temperature_ratio
-from sim.figures.style import figure, save
+from sim.analysis.theory import (
+    garzo_dufty_haff_temperature,
+    garzo_dufty_temperature_ratio,
+    kolafa_rottner_z,
+)
+from sim.checks import dsmc
+from sim.checks.rows import block_means
+from sim.figures.style import QUICK_FOLDER, figure, save
 
 NAME = "fig07_mixture_cooling"
 RESTITUTION = (1.0, 0.9, 0.8)
 #: collisions per disk (C/N) over which a run's ratio is averaged: the homogeneous cooling state
 WINDOW = (5.0, 30.0)
+#: the window's starts (C/N) whose effect the right panel shows, each to ``WINDOW[1]``
+STARTS = (2.0, 3.0, 5.0, 7.0, 10.0, 15.0, 20.0)
 #: disks and packing fraction: N φ = 16, L_c ≥ 1.31 box sides (module docstring)
 DISKS, PACKING = 800, 0.02
+#: particles and runs of the DSMC beside the engine (quick: a fifth of the particles, two runs)
+DSMC_DISKS, DSMC_SEEDS = 20000, 4
 
 
 def seeds(quick):
@@ -80,44 +101,117 @@ def ratio_over_runs(temperature, window):
     return curve, jackknife(curves), curve[window].mean(), jackknife(means)
 
 
+def beside(gas, restitution, times, quick):
+    """The DSMC of the figure's mixture ``gas`` (:class:`sim.checks.dsmc.Gas`) with ξ =
+    ``restitution`` from the runs' start (both species Maxwellian at T = 1), read out at
+    ``times``: (C/N [K], T_s float64[K, 2] averaged over the DSMC runs, and each run's mean
+    T₂/T₁ over ``WINDOW``)."""
+    particles, runs = (DSMC_DISKS // 5, 2) if quick else (DSMC_DISKS, DSMC_SEEDS)
+    series = [dsmc.run(gas, dsmc.SmoothDisks(restitution), particles, times, seed)[0]
+              for seed in range(runs)]
+    per_disk = np.mean([s.collisions_per_particle for s in series], axis=0)
+    window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
+    ratios = [np.mean(s.translational[window, 1] / s.translational[window, 0]) for s in series]
+    return per_disk, np.mean([s.translational for s in series], axis=0), ratios
+
+
+def relative(measured, error, reference, reference_error=0.0):
+    """measured/reference − 1 and its standard error (independent errors)."""
+    return (measured / reference - 1.0,
+            np.hypot(error / reference, measured * reference_error / reference**2))
+
+
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["cooling"])
     kind = _first(ds["species_id"], "disk")
     mass = _first(ds["mass"], "disk")
     masses = [float(mass[kind == s][0]) for s in (0, 1)]
     counts = np.array([np.sum(kind == s) for s in (0, 1)])
+    fractions = counts / counts.sum()
     area = float(np.prod(ds.attrs["box"]))
-    phi = float(np.sum(np.pi * _first(ds["radius"], "disk") ** 2)) / area
+    radius = _first(ds["radius"], "disk")
+    phi = float(np.sum(np.pi * radius**2)) / area
+    density, sigma = counts.sum() / area, 2.0 * float(radius.max())
+    chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
+    gas = dsmc.Gas(masses=tuple(masses), diameters=(sigma, sigma), fractions=tuple(fractions),
+                   density=density, chi=chi)
     # (restitution, seed, snapshot, species): kinetic energy per disk of each species
     temperature = ds["kinetic_energy_by_species"].transpose(
         "restitution_disk", "seed", "snapshot", "species").values / counts
+    time = ds["time"].transpose("restitution_disk", "seed", "snapshot").values.mean(axis=1)
     per_disk = _first(ds["collisions"], "snapshot") / counts.sum()
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
-    seeds = temperature.shape[1]
-    fig, (left, right) = figure(width=10)
-    rows = []
+    runs = temperature.shape[1]
+    quick = out_dir.name == QUICK_FOLDER
+    fig, (left, middle, right) = figure(ncols=3, width=15, height=4.4)
+    rows, window_rows = [], []
     for k, xi in enumerate(ds["restitution_disk"].values):
-        theory = garzo_dufty_temperature_ratio(masses, counts / counts.sum(), xi)
+        theory = garzo_dufty_temperature_ratio(masses, fractions, xi)
         curve, band, mean, error = ratio_over_runs(temperature[k], window)
-        rows.append((xi, theory, mean, error, seeds,
+        exact_per_disk, exact_temperature, exact_ratios = beside(gas, xi, time[k], quick)
+        exact, exact_error = block_means(exact_ratios)
+        off, off_error = relative(mean, error, exact, exact_error)
+        off_theory, off_theory_error = relative(mean, error, theory)
+        # the mixture temperature T = Σ x_s T_s of each run, against Haff's law from the
+        # window's first snapshot
+        mixture = temperature[k] @ fractions  # [runs, snapshots]
+        start = np.argmax(window)
+        haff = garzo_dufty_haff_temperature(time[k, start:] - time[k, start],
+                                            mixture[:, start].mean(), masses, fractions, xi,
+                                            density, sigma, chi)
+        end = mixture[:, -1] / haff[-1] - 1.0
+        rows.append((xi, theory, exact, exact_error, mean, error, off, off_error, off_theory,
+                     off_theory_error, end.mean(), end.std(ddof=1) / np.sqrt(runs), runs,
                      instability_length(xi, counts.sum(), phi, area)))
-        for s, style in ((0, "-"), (1, "--")):
-            left.semilogy(per_disk, temperature[k, :, :, s].mean(axis=0), style, color=f"C{k}",
-                          label=f"ξ = {xi:g}, m = {masses[s]:g}")
-        right.fill_between(per_disk, curve - band, curve + band, color=f"C{k}", alpha=0.25,
-                           lw=0)
-        right.plot(per_disk, curve, color=f"C{k}",
-                   label=f"ξ = {xi:g}: {mean:.3f} ± {error:.3f}")
-        right.axhline(theory, color=f"C{k}", ls=":", lw=1.2, label=f"Garzó–Dufty {theory:.3f}")
-    right.axvspan(*WINDOW, color="0.9", zorder=0, label="averaged (cooling state)")
-    left.set(xlabel="collisions per disk", ylabel="temperature T_s = E_s / N_s",
-             title="species temperatures (solid m = 1, dashed m = 4)")
-    left.legend(fontsize=7, ncol=2)
-    right.set(xlabel="collisions per disk", ylabel="T₂ / T₁ (m = 4 over m = 1)",
-              ylim=(0.9, 1.6),
-              title=f"{seeds} runs ± jackknife error, N = {counts.sum()}, φ = {phi:.3g}")
-    right.legend(fontsize=7, ncol=2, loc="upper left")
+        for first in STARTS:
+            _, _, from_start, its_error = ratio_over_runs(
+                temperature[k], (per_disk >= first) & (per_disk <= WINDOW[1]))
+            window_rows.append((xi, first, from_start, its_error))
+        left.loglog(time[k, 1:], mixture[:, 1:].mean(axis=0), color=f"C{k}", lw=4, alpha=0.4,
+                    label=f"ξ = {xi:g}")
+        left.loglog(time[k, 1:], exact_temperature[1:] @ fractions, color=f"C{k}", ls="--",
+                    lw=1.2)
+        if xi < 1.0:
+            left.loglog(time[k, start:], haff, color="k", ls=":", lw=1.2)
+        middle.fill_between(per_disk, curve - band, curve + band, color=f"C{k}", alpha=0.25,
+                            lw=0)
+        middle.plot(per_disk, curve, color=f"C{k}",
+                    label=f"ξ = {xi:g}: {mean:.3f} ± {error:.3f}; /DSMC − 1 = {off:+.3f} ± "
+                          f"{off_error:.3f}, /GD − 1 = {off_theory:+.3f} ± "
+                          f"{off_theory_error:.3f}")
+        middle.plot(exact_per_disk, exact_temperature[:, 1] / exact_temperature[:, 0],
+                    color=f"C{k}", ls="--", lw=1.2)
+        middle.axhline(theory, color=f"C{k}", ls=":", lw=1.2)
+        window_rows_k = np.array(window_rows[-len(STARTS):])
+        right.errorbar(window_rows_k[:, 1], window_rows_k[:, 2], yerr=window_rows_k[:, 3],
+                       fmt="o-", color=f"C{k}", capsize=3, ms=4, label=f"ξ = {xi:g}")
+        right.axhline(theory, color=f"C{k}", ls=":", lw=1.2)
+        right.axhline(exact, color=f"C{k}", ls="--", lw=1.2)
+    left.set(xlabel="t  [L √(m₁/T₀)]", ylabel="mixture temperature (T₁ + T₂)/2")
+    left.set_title("wide: mean of the runs; dashed: DSMC;\nblack dotted: Haff's law "
+                   "(Garzó–Dufty rate)",
+                   fontsize=9)
+    left.legend(fontsize=8)
+    middle.axvspan(*WINDOW, color="0.9", zorder=0)
+    middle.set(xlabel="collisions per disk", ylabel=f"T₂ / T₁ (m = {masses[1]:g} over "
+                                                    f"m = {masses[0]:g})", ylim=(0.9, 1.6))
+    middle.set_title(f"{runs} runs ± jackknife error, N = {counts.sum()}, φ = {phi:.3g};\n"
+                     f"dashed: DSMC; dotted: Garzó–Dufty (Maxwellian); grey: averaged",
+                     fontsize=9)
+    middle.legend(fontsize=6, loc="upper left")
+    right.set(xlabel="window start (collisions per disk)",
+              ylabel=f"T₂ / T₁ averaged from there to {WINDOW[1]:g}")
+    right.axvline(WINDOW[0], color="0.6", lw=1)
+    right.set_title("the window's effect; dashed: DSMC, dotted: Garzó–Dufty\n"
+                    f"(grey line: the start used, C/N = {WINDOW[0]:g})", fontsize=9)
+    right.legend(fontsize=8, loc="center right")
     np.savetxt(out_dir / f"{NAME}.csv", np.array(rows), delimiter=",", fmt="%.6g",
-               header="restitution,garzo_dufty_ratio,measured_ratio,standard_error,runs,"
+               header="restitution,garzo_dufty_ratio,dsmc_ratio,dsmc_standard_error,"
+                      "measured_ratio,standard_error,measured_over_dsmc_minus_1,its_error,"
+                      "measured_over_garzo_dufty_minus_1,its_error,"
+                      "temperature_over_haff_minus_1_at_the_end,its_error,runs,"
                       "instability_length", comments="")
+    np.savetxt(out_dir / f"{NAME}_window.csv", np.array(window_rows), delimiter=",",
+               fmt="%.6g", header=f"restitution,window_start,measured_ratio_to_{WINDOW[1]:g},"
+                                  "standard_error", comments="")
     return save(fig, out_dir, NAME)

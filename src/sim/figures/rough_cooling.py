@@ -7,7 +7,8 @@ two-temperature Maxwellian theory (:func:`sim.analysis.theory.rough_disk_tempera
 ``WINDOW`` with Enskog's collision frequency there) is an approximation: its closure
 neglects the fourth cumulants, and it misses the ratio by a few per cent, where DSMC solves
 the kinetic equation itself. The numbers file gives measured/DSMC − 1 and measured/theory −
-1, each with its standard error, and the runs.
+1 of the ratio, each with its standard error, the runs, and T_tr at the end of the runs
+against DSMC's and Haff's law (mean of the runs' T_tr(end)/T_tr(0), its standard error).
 
 T_tr is taken in the frame of the local flow on 4 × 4 cells
 (:func:`sim.analysis.datasets.granular_temperatures`), T_rot = ⟨I ω²⟩, both averaged over the
@@ -18,7 +19,7 @@ temperature T₀), averaged over the runs. The more nearly smooth the disks (β 
 weaker the coupling of spin and translation and the slower the climb (β = −0.5 has not
 settled after 12 collisions per disk, C/N, so it is not drawn). The gas is dilute and its
 box small against the length at which a cooling gas grows shear and clusters, L_c =
-2√π/(n σ √(1 − ξ²)) = 2.3 box sides for ξ = 0.9 at N = 500, φ = 0.02 (roughness dissipates
+2√π/(n σ √(1 − ξ²)) = 2.3 box sides for ξ = 0.9 at N = 2000, φ = 0.005 (roughness dissipates
 more per collision and shortens it somewhat), so that it stays homogeneous over the window.
 """
 
@@ -43,7 +44,7 @@ ROUGHNESS = (0.0, 0.5, 1.0)
 #: collisions per disk (C/N) over which a run's ratio is averaged: the homogeneous cooling state
 WINDOW = (7.0, 12.0)
 #: disks and packing fraction: the box is 2.3 clustering lengths of ξ = 0.9 (module docstring)
-DISKS, PACKING = 500, 0.02
+DISKS, PACKING = 2000, 0.005
 #: particles and runs of the DSMC beside the engine (quick: a fifth of the particles, two runs)
 DSMC_DISKS, DSMC_SEEDS = 20000, 4
 
@@ -116,32 +117,42 @@ def draw(runs, sweeps, out_dir):
         exact, exact_error = block_means(exact_ratios)
         off, off_error = ratio / exact - 1.0, np.hypot(error / exact,
                                                        ratio * exact_error / exact**2)
+        start = np.argmax(window)  # Haff's law from the first snapshot of the cooling state
+        frequency = enskog_collision_frequency(n, sigma, chi, translational[start])
+        haff = rough_disk_haff_temperature(time[start:] - time[start],
+                                           translational[start] / translational[0], frequency,
+                                           RESTITUTION, beta, q)
+        # each run's T_tr(end)/T_tr(0) against DSMC's and Haff's
+        cooled = np.array([c[0][-1] / c[0][0] for c in curves])
+        at_end = [(np.mean(cooled) / reference - 1.0, np.std(cooled, ddof=1) / np.sqrt(
+            cooled.size) / reference) for reference in (exact_tr[-1] / exact_tr[0], haff[-1])]
         rows.append((beta, exact, exact_error, theory, ratio, error, off, off_error,
-                     ratio / theory - 1.0, error / theory, len(ratios)))
+                     ratio / theory - 1.0, error / theory, len(ratios), *at_end[0],
+                     *at_end[1]))
         left.plot(per_disk, rotational / translational, color=f"C{k}",
                   label=f"β = {beta:g}: {ratio:.3f} ± {error:.3f}, /DSMC − 1 = "
                         f"{off:+.3f} ± {off_error:.3f}")
         left.plot(exact_per_disk, exact_rot / exact_tr, color=f"C{k}", ls="--", lw=1.2)
         left.axhline(theory, color=f"C{k}", ls=":", lw=1.2)
-        right.semilogy(time, translational / translational[0], color=f"C{k}",
-                       label=f"β = {beta:g}")
+        right.semilogy(time, translational / translational[0], color=f"C{k}", lw=4, alpha=0.4,
+                       label=f"β = {beta:g}: at the end /DSMC − 1 = {at_end[0][0]:+.3f} ± "
+                             f"{at_end[0][1]:.3f}, /Haff − 1 = {at_end[1][0]:+.3f} ± "
+                             f"{at_end[1][1]:.3f}")
         right.semilogy(time, exact_tr / exact_tr[0], color=f"C{k}", ls="--", lw=1.2)
-        start = np.argmax(window)  # Haff's law from the first snapshot of the cooling state
-        frequency = enskog_collision_frequency(n, sigma, chi, translational[start])
-        right.semilogy(time[start:], rough_disk_haff_temperature(
-            time[start:] - time[start], translational[start] / translational[0], frequency,
-            RESTITUTION, beta, q), color=f"C{k}", ls=":", lw=1.5)
+        right.semilogy(time[start:], haff, color="k", ls=":", lw=1.2)
     left.axvspan(*WINDOW, color="0.9", zorder=0, label="averaged (cooling state)")
     left.set(xlabel="collisions per disk", ylabel="T_rot / T_tr")
     left.set_title(f"ξ = {RESTITUTION}, q = {q}, N = {n}, φ = {phi:.3g}, {ds.sizes['seed']} "
                    f"runs\nsolid: engine; dashed: DSMC; dotted: Maxwellian theory", fontsize=9)
     left.legend(fontsize=7)
     right.set(xlabel="t  [L √(m/T₀)]", ylabel="T_tr / T_tr(0)")
-    right.set_title("T_tr, mean of the runs\ndashed: DSMC; dotted: Haff's law (Maxwellian "
-                    "theory)", fontsize=9)
+    right.set_title("T_tr, wide: mean of the runs; dashed: DSMC;\nblack dotted: Haff's law "
+                    f"(Maxwellian theory) from C/N = {WINDOW[0]:g}", fontsize=9)
     right.legend(fontsize=7)
     np.savetxt(out_dir / f"{NAME}.csv", np.array(rows), delimiter=",", fmt="%.6g",
                header="tangential_restitution,dsmc_ratio,dsmc_standard_error,theory_ratio,"
                       "measured_ratio,standard_error,measured_over_dsmc_minus_1,its_error,"
-                      "measured_over_theory_minus_1,its_error,runs", comments="")
+                      "measured_over_theory_minus_1,its_error,runs,"
+                      "temperature_at_the_end_over_dsmc_minus_1,its_error,"
+                      "temperature_at_the_end_over_haff_minus_1,its_error", comments="")
     return save(fig, out_dir, NAME)

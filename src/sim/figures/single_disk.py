@@ -42,7 +42,8 @@ def draw(runs, sweeps, out_dir):
                       - (half - radius)) / np.sqrt(2.0)
     right.semilogy(time, np.maximum(distance, 1e-17), ".", ms=2, color="C0")
     energy_error = np.abs(energy / energy[0] - 1.0).max()
-    right.set(xlabel="time", ylabel="distance from the rectangle (box units)",
+    right.set(xlabel="time  [L/v: box side over the disk's speed]",
+              ylabel="distance from the rectangle (box units)",
               title=f"largest distance {distance.max():.1e}; "
                     + ("energy exact" if energy_error == 0 else f"|E/E₀ − 1| ≤ {energy_error:.0e}"))
     np.savetxt(out_dir / f"{NAME}.csv",
