@@ -33,7 +33,8 @@ def draw(rows, about=None):
     kinds = [kind for kind in ENGINES if f"{kind}_collisions_per_s" in rows[0]]
     phis = sorted({row["phi"] for row in rows})
     rounds, chunk = rows[0]["rounds"], rows[0]["chunk"]
-    for marker, phi in zip(MARKERS, phis, strict=False):
+    for k, phi in enumerate(phis):
+        marker = MARKERS[k % len(MARKERS)]
         chosen = sorted((row for row in rows if row["phi"] == phi), key=lambda row: row["n"])
         n = [row["n"] for row in chosen]
         at_phi = f", φ = {phi:g}" if len(phis) > 1 else ""

@@ -49,7 +49,10 @@ def on_files(files, config):
     for name, path in images:
         files.append(File.generated(config, f"figures/{name}", abs_src_path=str(path)))
     for name in SHOWN_RESULTS:
-        files.get_file_from_path(name).inclusion = InclusionLevel.INCLUDED
+        shown = files.get_file_from_path(name)
+        if shown is None:
+            raise FileNotFoundError(f"docs/{name} is missing: make speed draws it")
+        shown.inclusion = InclusionLevel.INCLUDED
     return files
 
 

@@ -88,7 +88,8 @@ def garzo_dufty_haff_temperature(t, temperature0, masses, fractions, restitution
     :func:`garzo_dufty_temperature_ratio`, made absolute by the factor 2√(2π) n σ χ (with it,
     one species gives ζ = (1 − ξ²) n σ χ √(πT/m) = (1 − ξ²) ω/2, ω Enskog's collision frequency
     :func:`enskog_collision_frequency`). Maxwellian velocity distributions; ``n_density``
-    disks per unit area, ``sigma`` the diameter; ``t`` in the units of σ√(m/T)."""
+    disks per unit area, ``sigma`` the diameter (in one length unit L), ``t`` in L√(m/T) with
+    the masses' and temperatures' units."""
     x = np.asarray(fractions, dtype=float) / np.sum(fractions)
     ratio = garzo_dufty_temperature_ratio(masses, x, restitution)
     t1 = temperature0 / (x[0] + x[1] * ratio)

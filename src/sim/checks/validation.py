@@ -19,6 +19,7 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import brentq
 
+from sim.analysis.datasets import granular_temperatures
 from sim.analysis.theory import (
     enskog_collision_frequency,
     garzo_dufty_temperature_ratio,
@@ -27,7 +28,7 @@ from sim.analysis.theory import (
 )
 from sim.checks import dsmc
 from sim.checks.rough import rough_cooling, rough_equipartition
-from sim.checks.rows import Check, block_means
+from sim.checks.rows import Check, block_means, ratio_of_means
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
@@ -146,54 +147,62 @@ def cooling_gas(n, phi, restitution, seed, tc=None, mass=1.0, species=None):
     return engine, radius
 
 
-def haff_cooling(restitution, n=2000, phi=0.005, seed=5, runs=32, dsmc_particles=10000,
-                 dsmc_runs=8):
-    """Homogeneous cooling of smooth disks: E(C)/E₀ at C/N = 1/(1 − ξ²) and T(t₀)/T₀ at
+def haff_cooling(restitution, n=2000, phi=0.005, seed=5, runs=32, cells=4,
+                 dsmc_particles=10000, dsmc_runs=32):
+    """Homogeneous cooling of smooth disks: T(C)/T₀ at C/N = 1/(1 − ξ²) and T(t₀)/T₀ at
     t₀ = 4/((1 − ξ²) ω₀) (ω₀ Enskog's collision frequency at T₀, χ from Kolafa–Rottner), each
     the mean of ``runs`` runs (seeds ``seed``, ``seed + 1``, …) from the equilibrated elastic
     gas, against DSMC of the same Boltzmann–Enskog equation from a Maxwellian start
-    (:mod:`sim.checks.dsmc`, ``dsmc_runs`` runs of ``dsmc_particles``). Haff's law, which
-    takes the distribution as Maxwellian, is named beside them: E/E₀ = exp(−(1 − ξ²) C/N) =
-    1/e and T/T₀ = 1/(1 + t/t₀)² = 1/4 (the Sonine correction a₂ is below 1 % for ξ ≥ 0.7).
+    (:mod:`sim.checks.dsmc`, ``dsmc_runs`` runs of ``dsmc_particles``, t₀ from its own T₀).
+    Haff's law, which takes the distribution as Maxwellian, is named beside them:
+    T/T₀ = exp(−(1 − ξ²) C/N) = 1/e and T/T₀ = 1/(1 + t/t₀)² = 1/4 (the Sonine correction a₂
+    is below 1 % for ξ ≥ 0.7).
 
     The box is below the length at which a cooling gas grows shear and clusters,
     2√π/(nσ√(1 − ξ²)) (N φ = 10: 2.3 box sides at ξ = 0.9, 1.7 at ξ = 0.8), so that the gas
-    stays homogeneous (a larger box cools more slowly once its clusters grow, and the
-    Boltzmann equation of a homogeneous gas no longer describes it). Tolerances: four standard
-    errors of the difference (the runs' and DSMC's, in quadrature).
+    stays homogeneous; T is taken in the frame of the local flow on ``cells`` × ``cells``
+    cells (:func:`sim.analysis.datasets.granular_temperatures`), as in DSMC's homogeneous gas.
+    Tolerances: four standard errors of the difference (the runs' and DSMC's, in quadrature).
     """
     started = time.perf_counter()
     rate = 1.0 - restitution**2
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
-    energy_at_c, temperature_at_t0 = [], []
+    radius = radius_for_packing(n, phi)
+    kind = np.zeros(n, dtype=int)
+
+    def temperature(engine):
+        return granular_temperatures(engine.positions()[None], engine.velocities()[None],
+                                     engine.mass, kind, engine.box, cells)[0, 0]
+
+    cooled_by_collisions, cooled_in_time = [], []
     for realization in range(runs):
-        engine, radius = cooling_gas(n, phi, restitution, seed + realization)
-        e0 = engine.kinetic_energy()
-        t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, e0 / (n - 1)))
-        engine.run(collisions=round(n / rate))  # E/E₀ = 1/e comes before T/T₀ = 1/4
-        energy_at_c.append(engine.kinetic_energy() / e0)
+        engine, _ = cooling_gas(n, phi, restitution, seed + realization)
+        t_zero = temperature(engine)
+        t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, t_zero))
+        engine.run(collisions=round(n / rate))  # T/T₀ = 1/e comes before T/T₀ = 1/4
+        cooled_by_collisions.append(temperature(engine) / t_zero)
         engine.run(time=t0)
-        temperature_at_t0.append(engine.kinetic_energy() / e0)
+        cooled_in_time.append(temperature(engine) / t_zero)
     gas = dsmc.Gas(diameters=(2.0 * radius,), density=float(n), chi=chi)
     rule = dsmc.SmoothDisks(restitution)
-    exact_energy, exact_temperature = [], []
+    exact_by_collisions, exact_in_time = [], []
     for k in range(dsmc_runs):
         translational, _ = dsmc.at_collisions(gas, rule, dsmc_particles, [0.0, 1.0 / rate],
                                               seed + k)
-        exact_energy.append(translational[1, 0] / translational[0, 0])
+        exact_by_collisions.append(translational[1, 0] / translational[0, 0])
         rng = np.random.default_rng(seed + k)
         state = dsmc.initial_state(gas, dsmc_particles, rng)
         t_zero = dsmc.temperatures(gas, state)[0][0]
         t0 = 4.0 / (rate * enskog_collision_frequency(n, 2.0 * radius, chi, t_zero))
         series, _ = dsmc.simulate(gas, rule, state, [t0], rng)
-        exact_temperature.append(series.translational[0, 0] / t_zero)
+        exact_in_time.append(series.translational[0, 0] / t_zero)
     seconds = time.perf_counter() - started
     rows = []
     for name, measured, exact, haff, source in (
-            (f"Haff E(C)/E₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, N = {n}, φ = {phi}, "
-             f"mean of {runs} runs", energy_at_c, exact_energy, math.exp(-1.0),
-             "exp(−(1−ξ²)C/N)"),
-            (f"Haff T(t₀)/T₀, ξ = {restitution}", temperature_at_t0, exact_temperature, 0.25,
+            (f"Haff T(C)/T₀ at C/N = {1 / rate:.2f}, ξ = {restitution}, N = {n}, φ = {phi}, "
+             f"mean of {runs} runs", cooled_by_collisions, exact_by_collisions,
+             math.exp(-1.0), "exp(−(1−ξ²)C/N)"),
+            (f"Haff T(t₀)/T₀, ξ = {restitution}", cooled_in_time, exact_in_time, 0.25,
              "T₀/(1 + t/t₀)², Enskog ω₀")):
         value, error = block_means(measured)
         reference, reference_error = block_means(exact)
@@ -205,7 +214,7 @@ def haff_cooling(restitution, n=2000, phi=0.005, seed=5, runs=32, dsmc_particles
 
 
 def mixture_temperature_ratio(restitution, n=800, phi=0.02, mass_ratio=4.0, seed=7, runs=32,
-                              window=(5, 30), dsmc_particles=10000, dsmc_runs=8):
+                              window=(5, 30), cells=4, dsmc_particles=10000, dsmc_runs=16):
     """T₂/T₁ of an equimolar mixture of equal-size disks with m₂/m₁ = ``mass_ratio``, against
     equipartition (ξ = 1, exact) or, at ξ < 1, the homogeneous cooling state of the Boltzmann–
     Enskog equation solved by DSMC (:func:`sim.checks.dsmc.at_collisions`, the same masses,
@@ -213,34 +222,37 @@ def mixture_temperature_ratio(restitution, n=800, phi=0.02, mass_ratio=4.0, seed
     theory of Garzó & Dufty (1999) named beside it.
 
     The gas is that of figure 7: N φ = 16 puts the box below the length at which a cooling
-    gas grows shear and clusters (1.31 box sides at ξ = 0.8), so it stays homogeneous and the
-    species temperatures are T_s = E_s/N_s (zero total momentum). A larger box does not: at
-    N = 4000, φ = 0.1 (four such lengths) the ratio over C/N = 2 … 8 read 1.356 ± 0.008 in
-    the frame of the local flow against DSMC's 1.306 ± 0.002 over the same window. The ratio
-    is averaged over the snapshots at C/N = ``window[0]`` … ``window[1]``, one per collision
-    per disk; they are correlated within a run, so the error comes from ``runs`` independent
-    runs (seeds ``seed``, ``seed + 1``, …), each averaged over its snapshots, and DSMC's from
-    its ``dsmc_runs`` runs. Tolerance: four standard errors (both added in quadrature). At
-    ξ = 1 a second row tests the energies m v²/2 of both species together against the
-    exponential law with mean T (KS p-value above 0.01), which holds for any mass.
+    gas grows shear and clusters (1.31 box sides at ξ = 0.8), so it stays homogeneous. It
+    still carries some flow, more of it in the heavier species, so the temperatures are taken
+    in the frame of the local flow on ``cells`` × ``cells`` cells
+    (:func:`sim.analysis.datasets.granular_temperatures`, which also counts the degrees of
+    freedom the zero total momentum takes), as in DSMC's homogeneous gas. T₂/T₁ is the ratio of
+    the species temperatures averaged over the runs, at the snapshots at C/N = ``window[0]`` …
+    ``window[1]``, one per collision per disk, then over them, with its jackknife error over
+    ``runs`` independent runs (seeds ``seed``, ``seed + 1``, …;
+    :func:`sim.checks.rows.ratio_of_means`); DSMC's is the mean over its ``dsmc_runs`` runs.
+    Tolerance: four standard errors of the difference (both in quadrature). At ξ = 1 a second
+    row tests the energies m v²/2 of both species together against the exponential law with
+    mean T (KS p-value above 0.01), which holds for any mass.
     """
     started = time.perf_counter()
     species = np.arange(n) % 2
     mass = np.where(species == 1, mass_ratio, 1.0)
     marks = np.arange(window[0], window[1] + 1)
-    run_ratios, energies = [], []
+    temperatures, energies = [], []
     for run in range(runs):
         engine, _ = cooling_gas(n, phi, None if restitution == 1.0 else restitution,
                                 seed + run, mass=mass, species=species)
-        temperatures = []
+        positions, velocities = [], []
         for c_per_n in marks:
             engine.run(collisions=int(c_per_n * n))
-            energy = 0.5 * mass * np.sum(engine.velocities() ** 2, axis=1)
-            temperatures.append(np.bincount(species, weights=energy) / np.bincount(species))
-            energies.append(energy)
-        temperatures = np.array(temperatures)
-        run_ratios.append(np.mean(temperatures[:, 1] / temperatures[:, 0]))
-    ratio, error = block_means(run_ratios)
+            positions.append(engine.positions())
+            velocities.append(engine.velocities())
+        temperatures.append(granular_temperatures(np.array(positions), np.array(velocities),
+                                                  mass, species, engine.box, cells))
+        if restitution == 1.0:
+            energies.append(0.5 * mass * np.sum(velocities[0] ** 2, axis=1))
+    _, _, ratio, error = ratio_of_means(np.array(temperatures), np.ones(marks.size, bool))
     theory = garzo_dufty_temperature_ratio([1.0, mass_ratio], [0.5, 0.5], restitution)
     if restitution == 1.0:
         reference, reference_error, source = 1.0, 0.0, "equipartition"
@@ -259,9 +271,8 @@ def mixture_temperature_ratio(restitution, n=800, phi=0.02, mass_ratio=4.0, seed
                   f"φ = {phi}, C/N = {window[0]} … {window[1]}, mean of {runs} runs", ratio,
                   reference, 4.0 * math.hypot(error, reference_error), source, seconds)]
     if restitution == 1.0:
-        temperature = float(np.mean(np.concatenate(energies)))
-        p_value = stats.kstest(np.concatenate(energies[::len(marks)]),
-                               stats.expon(scale=temperature).cdf).pvalue
+        energies = np.concatenate(energies)
+        p_value = stats.kstest(energies, stats.expon(scale=energies.mean()).cdf).pvalue
         rows.append(Check("KS p-value, energies m v²/2 of both masses", p_value, 1.0, 0.99,
                           "exponential with mean T, any mass", None))
     return rows

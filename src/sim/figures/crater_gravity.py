@@ -18,12 +18,13 @@ its own); the figure gives the mean largest cavity over the beds with its standa
 
 The points curve in log–log (cavities near the projectile's own area πR² are shaped by its size
 and the grid more than by the energy, the largest ones feel the box), so no single power law
-is fitted: the middle panel gives the local exponent d ln A / d ln E between neighbouring
-energies (the standard errors of the two means in quadrature; the beds of one seed are the
-same at every speed, so neighbouring energies are not independent and that error is an
-estimate), beside β = 2/3 of the 2D gravity
-regime with energy scaling (the cavity's mass lifted by its own depth, E ~ ρ g R³;
-docs/physics.md, "Cratering"; momentum scaling gives smaller exponents).
+is fitted (the numbers file's header gives the χ² of the best single one through the means,
+:func:`sim.analysis.scaling.single_power_law`): the middle panel gives the local exponent
+d ln A / d ln E between neighbouring energies (the standard errors of the two means in
+quadrature; the beds of one seed are the same at every speed, so neighbouring energies are
+not independent and that error is an estimate), beside β = 2/3 of the 2D gravity regime with
+energy scaling (the cavity's mass lifted by its own depth, E ~ ρ g R³; docs/physics.md,
+"Cratering"; momentum scaling gives smaller exponents).
 """
 
 import numpy as np
@@ -32,6 +33,7 @@ from matplotlib.ticker import NullFormatter
 
 from sim.analysis.crater import calibrated_spacing, crater_area, preparation_of, require_stop
 from sim.analysis.datasets import open_sweep
+from sim.analysis.scaling import local_exponents, single_power_law
 from sim.figures.style import figure, save
 
 NAME = "fig11_crater_gravity"
@@ -86,11 +88,9 @@ def draw(runs, sweeps, out_dir):
     mean_energy = energy.mean(axis=1)
     area, area_error = largest.mean(axis=1), largest.std(axis=1, ddof=1) / np.sqrt(beds)
     final_area = final.mean(axis=1)
-    # d ln A / d ln E between neighbouring energies, at their geometric midpoints
-    step = np.log(mean_energy[1:] / mean_energy[:-1])
-    relative = area_error / area
-    local = np.log(area[1:] / area[:-1]) / step
-    local_error = np.hypot(relative[1:], relative[:-1]) / step
+    middle_energy, local, local_error = local_exponents(mean_energy, area, area_error)
+    slope, slope_error, chi_square, freedom, p_value = single_power_law(mean_energy, area,
+                                                                        area_error)
     projectile_area = np.pi * float(ds["radius"].values.flat[-1]) ** 2
     fig, (left, middle, right) = figure(ncols=3, width=14)
     fig.suptitle(preparation_of(ds), fontsize=9)
@@ -101,8 +101,9 @@ def draw(runs, sweeps, out_dir):
              xlabel="impact energy E (bed-disk mass × g × box length)",
              ylabel="crater area A (box units²)", title="transient crater under gravity")
     left.legend(fontsize=8)
-    middle.errorbar(np.sqrt(mean_energy[1:] * mean_energy[:-1]), local, yerr=local_error,
-                    fmt="o-", color="C1", capsize=3, label="between neighbouring energies")
+    middle.errorbar(middle_energy, local, yerr=local_error, fmt="o-", color="C1", capsize=3,
+                    label=f"between neighbouring energies (one power law: χ² = "
+                          f"{chi_square:.0f} for {freedom})")
     middle.axhline(2.0 / 3.0, color="k", ls=":", lw=1, label="2/3: 2D gravity, energy scaling")
     middle.set(xscale="log", xlabel="impact energy E", ylabel="local exponent d ln A / d ln E",
                title="the slope of the left panel")
@@ -125,6 +126,8 @@ def draw(runs, sweeps, out_dir):
                delimiter=",", fmt="%.6g",
                header=f"projectile_speed,impact_energy,largest_cavity_area,its_error,"
                       f"final_cavity_area,beds,local_exponent_to_next,its_error  (means over "
-                      f"the beds; no power law fitted: the local exponent is not constant; "
-                      f"projectile area {projectile_area:.6g})", comments="")
+                      f"the beds; no power law fitted: the best single one through the means "
+                      f"has chi2 = {chi_square:.3g} for {freedom} degrees of freedom, p = "
+                      f"{p_value:.2g}, exponent {slope:.3f} +- {slope_error:.3f}; projectile "
+                      f"area {projectile_area:.6g})", comments="")
     return save(fig, out_dir, NAME)

@@ -17,14 +17,18 @@ any reaches the floor. A single exponent through these points would be an averag
 range, not a scaling law; geometric similarity (α = 2, area ∝ mass) would need grains much
 smaller than the projectile and a bed much deeper than the crater. The beds of one seed are the
 same at every radius, so neighbouring radii are not independent, and the errors of the local
-exponent (the standard errors of the two means, added in quadrature) are an estimate. The
-numbers file gives, per radius, the mean area over the beds not floor-limited, its standard
-error, the number of floor-limited beds, and the local exponent to the next radius.
+exponent (the standard errors of the two means, added in quadrature) and the χ² of the best
+single power law through the means (in the numbers file's header and the legend) are
+estimates. The numbers file gives, per radius, the mean area over the beds not
+floor-limited, its standard error, the number of floor-limited beds, and the local exponent
+to the next radius.
 """
 
 import numpy as np
+
 from sim.analysis.crater import CraterGeometry, crater_overrides, preparation_of
 from sim.analysis.datasets import at_last_snapshot, open_sweep
+from sim.analysis.scaling import local_exponents, single_power_law
 from sim.figures.style import figure, save
 
 NAME = "fig09_crater_radius"
@@ -55,6 +59,14 @@ def floor_limited(run):
     return bool(lowest < FLOOR_GAP * 2.0 * radius[0])
 
 
+def to_next(values, measured):
+    """``values`` between neighbouring measured radii as a column over all radii: each at the
+    first radius of its pair, NaN elsewhere."""
+    column = np.full(measured.size, np.nan)
+    column[np.flatnonzero(measured)[:-1]] = values
+    return column
+
+
 def draw(runs, sweeps, out_dir):
     ds = open_sweep(sweeps["radius"])
     radius = ds["projectile_radius"].values
@@ -81,11 +93,11 @@ def draw(runs, sweeps, out_dir):
     mean = np.array([area[i, free[i]].mean() if beds[i] else np.nan for i in range(radius.size)])
     error = np.array([area[i, free[i]].std(ddof=1) / np.sqrt(beds[i]) if beds[i] > 1 else np.nan
                       for i in range(radius.size)])
-    # d ln A / d ln R between neighbouring radii, at their geometric midpoints
-    step = np.log(radius[1:] / radius[:-1])
-    local = np.log(mean[1:] / mean[:-1]) / step
-    relative = error / mean
-    local_error = np.hypot(relative[1:], relative[:-1]) / step
+    measured = beds > 1  # radii with a mean and its error
+    middle, local, local_error = local_exponents(radius[measured], mean[measured],
+                                                 error[measured])
+    slope, slope_error, chi_square, freedom, p_value = single_power_law(
+        radius[measured], mean[measured], error[measured])
     fig, (left, right) = figure(width=10)
     curve = np.geomspace(radius.min(), radius.max(), 100)
     left.loglog(radius_of_run[free], area[free], "o", color="C0", ms=3, alpha=0.4, label="one bed")
@@ -98,8 +110,9 @@ def draw(runs, sweeps, out_dir):
     left.set(xlabel="projectile radius R (box units)", ylabel="crater area A (box units²)",
              title=f"area at 10 % energy left, {seed.size} beds per radius")
     left.legend(fontsize=8)
-    right.errorbar(np.sqrt(radius[1:] * radius[:-1]), local, yerr=local_error, fmt="o-",
-                   color="C1", capsize=3, label="between neighbouring radii")
+    right.errorbar(middle, local, yerr=local_error, fmt="o-", color="C1", capsize=3,
+                   label=f"between neighbouring radii (one power law: χ² = {chi_square:.0f} "
+                         f"for {freedom})")
     right.set_xscale("log")
     right.axhline(2.0, color="k", ls=":", lw=1, label="2: geometric similarity (A ∝ mass)")
     right.set(xlabel="projectile radius R (box units)", ylabel="local exponent d ln A / d ln R",
@@ -109,9 +122,11 @@ def draw(runs, sweeps, out_dir):
     header = (f"projectile_radius,projectile_mass,crater_area_mean,crater_area_error,"
               f"floor_limited_beds,local_exponent_to_next,its_error  (means over the "
               f"{int(free.sum())} beds not floor-limited of {free.size}; no power law fitted: "
-              f"the local exponent is not constant)")
+              f"the best single one through the means has chi2 = {chi_square:.3g} for "
+              f"{freedom} degrees of freedom, p = {p_value:.2g}, exponent {slope:.3f} +- "
+              f"{slope_error:.3f})")
     np.savetxt(out_dir / f"{NAME}.csv",
                np.column_stack([radius, mass, mean, error, floor.sum(axis=1),
-                                np.append(local, np.nan), np.append(local_error, np.nan)]),
+                                to_next(local, measured), to_next(local_error, measured)]),
                delimiter=",", fmt="%.6g", header=header, comments="")
     return save(fig, out_dir, NAME)

@@ -10,9 +10,9 @@ so the stops are different stages of the impact. The two are therefore compared 
 time after the launch (in 10 L/v₀, L the box side and v₀ = 10 the launch speed): snapshots
 every ``SPACING``, and for each bed the last snapshot that both its smooth and its
 rough run reached, within ``SPACING`` of the earlier stop (left panel: the area of each run
-against time, the compared time marked). The ratio A(rough)/A(smooth) is taken bed by bed (the
-same seed, the same bed) and averaged over the beds, with its standard error. The projectile
-that reaches the floor in a smooth bed (R = 0.08, figure 9) is left out: its crater is the
+against time, the compared time marked). The ratio A(rough)/A(smooth) is taken bed by bed
+(the same seed, the same bed) and averaged over the beds, with its standard error.
+Projectiles that reach the floor in figure 9 (R ≥ 0.07) are not run: their crater is the
 box's; a bed whose smooth or rough run still reaches the floor is left out of the ratio and
 counted in the numbers file.
 
@@ -24,6 +24,7 @@ import numpy as np
 
 from sim.analysis.crater import CraterGeometry, crater_overrides
 from sim.analysis.datasets import open_sweep
+from sim.checks.rows import block_means
 from sim.figures.crater_radius import floor_limited
 from sim.figures.style import figure, save
 
@@ -71,10 +72,13 @@ def crater_in_time(run):
 def compared(smooth, rough):
     """The index of the last snapshot at the same time in both runs (each a pair of times and
     areas from :func:`crater_in_time`): the runs share their snapshot times up to the earlier
-    stop, whose own snapshot lies off that grid."""
+    stop, whose own snapshot lies off that grid. ValueError when they share only the start."""
     k = min(smooth[0].size, rough[0].size) - 1
-    while smooth[0][k] != rough[0][k]:
+    while k > 0 and smooth[0][k] != rough[0][k]:
         k -= 1
+    if k == 0:
+        raise ValueError("a smooth and a rough run share no snapshot time after the start: "
+                         "run both with the same output.every_time")
     return k
 
 
@@ -98,14 +102,12 @@ def draw(runs, sweeps, out_dir):
                 left.plot(time, area, color=f"C{i}", ls=("-", "--")[kind], lw=0.8, alpha=0.6,
                           label=(f"R = {r:g}" if kind == 0 and j == 0 else None))
             left.plot(smooth[0][k], smooth[1][k], "o", color=f"C{i}", ms=3)
+        if len(pairs) < 2:
+            raise ValueError(f"at R = {r:g}, {floors} of {beds} beds reached the floor: too "
+                             f"few left to compare")
         time, smooth_area, rough_area = np.array(pairs).T
-        ratio = rough_area / smooth_area
-
-        def mean_error(values):
-            return values.mean(), values.std(ddof=1) / np.sqrt(values.size)
-
-        rows.append((r, time.mean(), *mean_error(smooth_area), *mean_error(rough_area),
-                     *mean_error(ratio), len(pairs), floors))
+        rows.append((r, time.mean(), *block_means(smooth_area), *block_means(rough_area),
+                     *block_means(rough_area / smooth_area), len(pairs), floors))
     rows = np.array(rows)
     left.set(xlabel="time after launch  [10 L/v₀: box side L, launch speed v₀ = 10]",
              ylabel="crater area A (box units²)")

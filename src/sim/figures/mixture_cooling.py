@@ -7,15 +7,18 @@ momentum, random positions in a dilute periodic gas. The box is kept below the l
 which a cooling gas grows shear and clusters, L_c = 2√π / (n σ √(1 − ξ²)) (n the number
 density, σ the diameter), by the choice of N φ: with φ fixed, n σ grows as √(N φ), and
 N φ = 16 puts L_c at 1.31 box sides for the smallest ξ = 0.8 (more for ξ = 0.9), so the gas
-stays homogeneous at every stage and the species temperatures are the kinetic energies per
-disk (2D, k_B = 1: T_s = E_s/N_s), no flow to subtract.
+stays homogeneous at every stage. A cooling gas still carries flow below that length (its
+shear modes, excited by fluctuations, decay more slowly than the heat), and the heavier
+species carries more of it, so the species temperatures are taken in the frame of the local
+flow on ``CELLS`` × ``CELLS`` cells, momentum-corrected
+(:func:`sim.analysis.datasets.granular_temperatures`), as DSMC's homogeneous gas has none.
 
 The window rule: the ratio leaves T₂/T₁ = 1 within the first few collisions per disk (C/N)
 and the homogeneous cooling state is averaged over C/N from ``WINDOW[0]`` to the end of the
 runs, ``WINDOW[1]``. The right panel shows the window's effect: the mean from each start in
 ``STARTS`` to the end, with its error. The ratio is that of the species temperatures averaged
 over the independent runs (seeds), at each snapshot, then over the window; its error is the
-jackknife standard error over the runs (:func:`ratio_over_runs`).
+jackknife standard error over the runs (:func:`sim.checks.rows.ratio_of_means`).
 
 Two references. Garzó & Dufty take both velocity distributions as Maxwellian (the leading
 Sonine order) and the Enskog collision rate, which cancels in the ratio for equal sizes; DSMC
@@ -24,7 +27,8 @@ solves the same Boltzmann–Enskog equation without that approximation
 the runs' mean times, ``DSMC_DISKS`` particles, ``DSMC_SEEDS`` runs). The left panel gives the
 mixture temperature T = (T₁ + T₂)/2 against time, beside DSMC's and Haff's law with the
 Garzó–Dufty cooling rate from the window's first snapshot
-(:func:`sim.analysis.theory.garzo_dufty_haff_temperature`). Time is in units of L√(m₁/T₀)
+(:func:`sim.analysis.theory.garzo_dufty_haff_temperature`), each run against the law from
+its own temperature there. Time is in units of L√(m₁/T₀)
 (box side L, the lighter mass m₁, initial temperature T₀), averaged over the runs. L_c is the
 estimate of a gas of one mass, with the elastic gas's viscosity, applied to the mixture; the
 margin of 31 % covers that.
@@ -32,14 +36,14 @@ margin of 31 % covers that.
 
 import numpy as np
 
-from sim.analysis.datasets import open_sweep
+from sim.analysis.datasets import granular_temperatures, open_sweep
 from sim.analysis.theory import (
     garzo_dufty_haff_temperature,
     garzo_dufty_temperature_ratio,
     kolafa_rottner_z,
 )
 from sim.checks import dsmc
-from sim.checks.rows import block_means
+from sim.checks.rows import block_means, ratio_of_means, relative_difference
 from sim.figures.style import QUICK_FOLDER, figure, save
 
 NAME = "fig07_mixture_cooling"
@@ -50,8 +54,10 @@ WINDOW = (5.0, 30.0)
 STARTS = (2.0, 3.0, 5.0, 7.0, 10.0, 15.0, 20.0)
 #: disks and packing fraction: N φ = 16, L_c ≥ 1.31 box sides (module docstring)
 DISKS, PACKING = 800, 0.02
-#: particles and runs of the DSMC beside the engine (quick: a fifth of the particles, two runs)
-DSMC_DISKS, DSMC_SEEDS = 20000, 4
+#: cells along a side of the grid on which the local flow is subtracted (50 disks a cell)
+CELLS = 4
+#: particles and runs of the DSMC beside the engine (quick: a fifth of the particles, 4 runs)
+DSMC_DISKS, DSMC_SEEDS = 10000, 16
 
 
 def seeds(quick):
@@ -83,42 +89,21 @@ def _first(array, keep):
     return array.isel({d: 0 for d in array.dims if d != keep}).values
 
 
-def ratio_over_runs(temperature, window):
-    """T₂/T₁ of the runs together: the ratio of their mean temperatures at each snapshot
-    (a mean of per-run ratios would carry the bias E[T₂/T₁] − E[T₂]/E[T₁], about 1/N_s),
-    and its mean over the snapshots in ``window``, each with its jackknife standard error
-    over the runs (leave one run out). ``temperature``: float64[runs, snapshots, 2].
-    Returns (curve [snapshots], its error, window mean, its error)."""
-    runs = temperature.shape[0]
-    curve = temperature[:, :, 1].mean(axis=0) / temperature[:, :, 0].mean(axis=0)
-    left_out = np.array([np.delete(temperature, j, axis=0).mean(axis=0) for j in range(runs)])
-    curves = left_out[:, :, 1] / left_out[:, :, 0]  # [runs, snapshots]
-    means = curves[:, window].mean(axis=1)
-
-    def jackknife(values):
-        return np.sqrt((runs - 1) / runs * np.sum((values - values.mean(axis=0)) ** 2, axis=0))
-
-    return curve, jackknife(curves), curve[window].mean(), jackknife(means)
-
-
 def beside(gas, restitution, times, quick):
     """The DSMC of the figure's mixture ``gas`` (:class:`sim.checks.dsmc.Gas`) with ξ =
     ``restitution`` from the runs' start (both species Maxwellian at T = 1), read out at
-    ``times``: (C/N [K], T_s float64[K, 2] averaged over the DSMC runs, and each run's mean
-    T₂/T₁ over ``WINDOW``)."""
-    particles, runs = (DSMC_DISKS // 5, 2) if quick else (DSMC_DISKS, DSMC_SEEDS)
+    ``times``: (C/N [K], T_s float64[K, 2] averaged over the DSMC runs, each run's mean T₂/T₁
+    over ``WINDOW``, and each run's mixture temperature at the end over that at the start)."""
+    particles, runs = (DSMC_DISKS // 5, 4) if quick else (DSMC_DISKS, DSMC_SEEDS)
     series = [dsmc.run(gas, dsmc.SmoothDisks(restitution), particles, times, seed)[0]
               for seed in range(runs)]
     per_disk = np.mean([s.collisions_per_particle for s in series], axis=0)
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     ratios = [np.mean(s.translational[window, 1] / s.translational[window, 0]) for s in series]
-    return per_disk, np.mean([s.translational for s in series], axis=0), ratios
-
-
-def relative(measured, error, reference, reference_error=0.0):
-    """measured/reference − 1 and its standard error (independent errors)."""
-    return (measured / reference - 1.0,
-            np.hypot(error / reference, measured * reference_error / reference**2))
+    fractions = np.asarray(gas.fractions) / np.sum(gas.fractions)
+    cooled = [(s.translational[-1] @ fractions) / (s.translational[0] @ fractions)
+              for s in series]
+    return per_disk, np.mean([s.translational for s in series], axis=0), ratios, cooled
 
 
 def draw(runs, sweeps, out_dir):
@@ -135,10 +120,20 @@ def draw(runs, sweeps, out_dir):
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
     gas = dsmc.Gas(masses=tuple(masses), diameters=(sigma, sigma), fractions=tuple(fractions),
                    density=density, chi=chi)
-    # (restitution, seed, snapshot, species): kinetic energy per disk of each species
-    temperature = ds["kinetic_energy_by_species"].transpose(
-        "restitution_disk", "seed", "snapshot", "species").values / counts
-    time = ds["time"].transpose("restitution_disk", "seed", "snapshot").values.mean(axis=1)
+    # (restitution, seed, snapshot, species): temperatures in the frame of the local flow
+    position = ds["position"].transpose("restitution_disk", "seed", "snapshot", "disk",
+                                        "axis").values
+    velocity = ds["velocity"].transpose("restitution_disk", "seed", "snapshot", "disk",
+                                        "axis").values
+    # each run (seed) places its own species: its masses and species ids
+    run_mass = ds["mass"].transpose("seed", "disk").values
+    run_kind = ds["species_id"].transpose("seed", "disk").values
+    temperature = np.array([[granular_temperatures(position[k, j], velocity[k, j], run_mass[j],
+                                                   run_kind[j], ds.attrs["box"], CELLS)
+                             for j in range(position.shape[1])]
+                            for k in range(position.shape[0])])
+    run_time = ds["time"].transpose("restitution_disk", "seed", "snapshot").values
+    time = run_time.mean(axis=1)
     per_disk = _first(ds["collisions"], "snapshot") / counts.sum()
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     runs = temperature.shape[1]
@@ -147,24 +142,27 @@ def draw(runs, sweeps, out_dir):
     rows, window_rows = [], []
     for k, xi in enumerate(ds["restitution_disk"].values):
         theory = garzo_dufty_temperature_ratio(masses, fractions, xi)
-        curve, band, mean, error = ratio_over_runs(temperature[k], window)
-        exact_per_disk, exact_temperature, exact_ratios = beside(gas, xi, time[k], quick)
+        curve, band, mean, error = ratio_of_means(temperature[k], window)
+        exact_per_disk, exact_temperature, exact_ratios, exact_cooled = beside(
+            gas, xi, time[k], quick)
         exact, exact_error = block_means(exact_ratios)
-        off, off_error = relative(mean, error, exact, exact_error)
-        off_theory, off_theory_error = relative(mean, error, theory)
-        # the mixture temperature T = Σ x_s T_s of each run, against Haff's law from the
-        # window's first snapshot
+        off, off_error = relative_difference(mean, error, exact, exact_error)
+        off_theory, off_theory_error = relative_difference(mean, error, theory)
+        # the mixture temperature T = Σ x_s T_s of each run, at the end against its own start
+        # (DSMC's) and against Haff's law from its own temperature at the window's start
         mixture = temperature[k] @ fractions  # [runs, snapshots]
         start = np.argmax(window)
-        haff = garzo_dufty_haff_temperature(time[k, start:] - time[k, start],
-                                            mixture[:, start].mean(), masses, fractions, xi,
-                                            density, sigma, chi)
-        end = mixture[:, -1] / haff[-1] - 1.0
+        haff = np.array([garzo_dufty_haff_temperature(t[start:] - t[start], m[start], masses,
+                                                      fractions, xi, density, sigma, chi)
+                         for m, t in zip(mixture, run_time[k], strict=True)])
+        to_dsmc = relative_difference(*block_means(mixture[:, -1] / mixture[:, 0]),
+                                      *block_means(exact_cooled))
+        to_haff = relative_difference(*block_means(mixture[:, -1] / haff[:, -1]), 1.0)
         rows.append((xi, theory, exact, exact_error, mean, error, off, off_error, off_theory,
-                     off_theory_error, end.mean(), end.std(ddof=1) / np.sqrt(runs), runs,
+                     off_theory_error, *to_dsmc, *to_haff, runs,
                      instability_length(xi, counts.sum(), phi, area)))
         for first in STARTS:
-            _, _, from_start, its_error = ratio_over_runs(
+            _, _, from_start, its_error = ratio_of_means(
                 temperature[k], (per_disk >= first) & (per_disk <= WINDOW[1]))
             window_rows.append((xi, first, from_start, its_error))
         left.loglog(time[k, 1:], mixture[:, 1:].mean(axis=0), color=f"C{k}", lw=4, alpha=0.4,
@@ -172,7 +170,7 @@ def draw(runs, sweeps, out_dir):
         left.loglog(time[k, 1:], exact_temperature[1:] @ fractions, color=f"C{k}", ls="--",
                     lw=1.2)
         if xi < 1.0:
-            left.loglog(time[k, start:], haff, color="k", ls=":", lw=1.2)
+            left.loglog(time[k, start:], haff.mean(axis=0), color="k", ls=":", lw=1.2)
         middle.fill_between(per_disk, curve - band, curve + band, color=f"C{k}", alpha=0.25,
                             lw=0)
         middle.plot(per_disk, curve, color=f"C{k}",
@@ -209,7 +207,8 @@ def draw(runs, sweeps, out_dir):
                header="restitution,garzo_dufty_ratio,dsmc_ratio,dsmc_standard_error,"
                       "measured_ratio,standard_error,measured_over_dsmc_minus_1,its_error,"
                       "measured_over_garzo_dufty_minus_1,its_error,"
-                      "temperature_over_haff_minus_1_at_the_end,its_error,runs,"
+                      "temperature_at_the_end_over_dsmc_minus_1,its_error,"
+                      "temperature_at_the_end_over_haff_minus_1,its_error,runs,"
                       "instability_length", comments="")
     np.savetxt(out_dir / f"{NAME}_window.csv", np.array(window_rows), delimiter=",",
                fmt="%.6g", header=f"restitution,window_start,measured_ratio_to_{WINDOW[1]:g},"

@@ -4,21 +4,18 @@ red.
 
 Every frame is a snapshot of its run, so none is drawn in free flight across contacts. Two
 disks: snapshots every 0.0125 (``output.every_time``), 60 frames per second, in which a disk
-(speed at most 1.3) moves at most 1.6 % of the box, from t = 8, just before their first
+(speed at most 1.3) moves under 2 % of the box, from t = 8, just before their first
 collision, to 14.5 (quick: to 10). Crater: snapshots every 0.001 (quick 0.002) until t = 0.13,
-near the study's stop at 10 % of the energy; the projectile falls 1 % of the box per frame
-(quick 2 %) before it hits, and no disk moves farther; speed on a log scale over three decades
-up to the fastest disk of any frame, 0.0115 to 11.5 (a bed disk kicked by the projectile,
-which falls at 10; quick 0.0109 to 10.9), so that neither the impact saturates nor the bed's
-slow flow vanishes. Cooling: the gas cools by Haff's law, T = T0 / (1 + t/t0)², then
-clusters, its rms speed falling eightyfold by t = 100, so that frames equal in time would move
-a disk up to 20 % of the box between the first two and 1 % at the end; instead a frame at each
-snapshot, every 1500 collisions (``output.every_collisions``, 0.75 per disk), 498 frames until
-t = 100, long enough for the clusters to grow: 41 frames before t = 1, a disk moving at most
-2.0 % of the box between frames (median 1.0 %), the clock showing the unequal steps in time
-(0.0055 to 0.47). Quick: 1000 disks, every 200 collisions (0.4 per disk) until t = 40, a box
-too small for clusters to last: 261 frames, at most 3.7 % of the box between frames (median
-1.7 %).
+near the study's stop at 10 % of the energy; the projectile, falling at 10, moves 1 % of the
+box per frame (quick 2 %) before it hits; speed on a log scale over three decades up to the
+fastest disk of any frame (:mod:`sim.figures.movie.colors`), so that neither the impact
+saturates nor the bed's slow flow vanishes. Cooling: the gas cools by Haff's law,
+T = T0 / (1 + t/t0)², then clusters, so that frames equal in time would move a disk far in
+the first frames and hardly at all in the last; instead a frame at each snapshot, every 1500
+collisions (``output.every_collisions``: a disk takes part in 1.5 collisions between frames
+on average, and so moves about as far at every stage), until t = 100, long enough for the clusters
+to grow, the clock showing the unequal steps in time. Quick: 1000 disks, every 200 collisions
+(0.4 per disk) until t = 40, a box too small for clusters to last.
 """
 
 from sim.analysis.crater import crater_overrides

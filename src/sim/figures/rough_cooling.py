@@ -4,7 +4,8 @@ the DSMC solution of the same Boltzmann–Enskog equation (:mod:`sim.checks.dsmc
 the ratio of the homogeneous cooling state; from there on T_tr falls as Haff's law. The
 two-temperature Maxwellian theory (:func:`sim.analysis.theory.rough_disk_temperature_ratio`,
 :func:`sim.analysis.theory.rough_disk_haff_temperature` from the first snapshot of
-``WINDOW`` with Enskog's collision frequency there) is an approximation: its closure
+``WINDOW`` with Enskog's collision frequency there, each run from its own T_tr) is an
+approximation: its closure
 neglects the fourth cumulants, and it misses the ratio by a few per cent, where DSMC solves
 the kinetic equation itself. The numbers file gives measured/DSMC − 1 and measured/theory −
 1 of the ratio, each with its standard error, the runs, and T_tr at the end of the runs
@@ -34,7 +35,7 @@ from sim.analysis.theory import (
     rough_disk_temperature_ratio,
 )
 from sim.checks import dsmc
-from sim.checks.rows import block_means
+from sim.checks.rows import block_means, relative_difference
 from sim.effects.rotation import moment_of_inertia
 from sim.figures.style import QUICK_FOLDER, figure, save
 
@@ -43,10 +44,10 @@ RESTITUTION = 0.9
 ROUGHNESS = (0.0, 0.5, 1.0)
 #: collisions per disk (C/N) over which a run's ratio is averaged: the homogeneous cooling state
 WINDOW = (7.0, 12.0)
-#: disks and packing fraction: the box is 2.3 clustering lengths of ξ = 0.9 (module docstring)
+#: disks and packing fraction: the clustering length of ξ = 0.9 is 2.3 box sides (module docstring)
 DISKS, PACKING = 2000, 0.005
-#: particles and runs of the DSMC beside the engine (quick: a fifth of the particles, two runs)
-DSMC_DISKS, DSMC_SEEDS = 20000, 4
+#: particles and runs of the DSMC beside the engine (quick: a fifth of the particles, 4 runs)
+DSMC_DISKS, DSMC_SEEDS = 10000, 16
 
 
 def sweeps(quick):
@@ -74,17 +75,19 @@ def beside(n, sigma, chi, q, beta, temperature, times, quick):
     """The DSMC of the figure's gas (density ``n`` disks per unit area, diameter ``sigma``,
     Enskog factor ``chi``, q, ξ = :data:`RESTITUTION`, β) from the runs' start (Maxwellian
     at ``temperature``, spins at rest), read out at ``times``: (C/N [K], T_tr [K], T_rot [K]),
-    each float64 averaged over the DSMC runs, and the runs' window means of T_rot/T_tr."""
+    each float64 averaged over the DSMC runs, the runs' window means of T_rot/T_tr, and their
+    T_tr at the end over that at the start)."""
     gas = dsmc.Gas(diameters=(sigma,), density=n, chi=chi, inertia_factor=q)
     rule = dsmc.RoughDisks(RESTITUTION, beta)
-    particles, seeds = (DSMC_DISKS // 5, 2) if quick else (DSMC_DISKS, DSMC_SEEDS)
+    particles, seeds = (DSMC_DISKS // 5, 4) if quick else (DSMC_DISKS, DSMC_SEEDS)
     series = [dsmc.run(gas, rule, particles, times, seed, temperature=temperature)[0]
               for seed in range(seeds)]
     per_disk = np.mean([s.collisions_per_particle for s in series], axis=0)
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     ratios = [np.mean(s.rotational[window, 0] / s.translational[window, 0]) for s in series]
     return (per_disk, np.mean([s.translational[:, 0] for s in series], axis=0),
-            np.mean([s.rotational[:, 0] for s in series], axis=0), ratios)
+            np.mean([s.rotational[:, 0] for s in series], axis=0), ratios,
+            [s.translational[-1, 0] / s.translational[0, 0] for s in series])
 
 
 def draw(runs, sweeps, out_dir):
@@ -95,6 +98,7 @@ def draw(runs, sweeps, out_dir):
     window = (per_disk >= WINDOW[0]) & (per_disk <= WINDOW[1])
     n = ds.sizes["disk"]
     area = float(np.prod(ds.attrs["box"]))
+    density = n / area
     phi = float(np.sum(np.pi * ds["radius"] ** 2) / area)
     chi = (kolafa_rottner_z(phi) - 1.0) / (2.0 * phi)
     sigma = 2.0 * float(ds["radius"].max())
@@ -108,38 +112,41 @@ def draw(runs, sweeps, out_dir):
             curves.append((translational, rotational))
             ratios.append(np.mean(rotational[window] / translational[window]))
             times.append(run["time"].values)
-        translational, rotational = np.mean(curves, axis=0)
         time = np.mean(times, axis=0)
         ratio, error = block_means(ratios)
         theory = rough_disk_temperature_ratio(RESTITUTION, beta, q)
-        exact_per_disk, exact_tr, exact_rot, exact_ratios = beside(
-            n / area, sigma, chi, q, beta, translational[0], time, out_dir.name == QUICK_FOLDER)
+        exact_per_disk, exact_tr, exact_rot, exact_ratios, exact_cooled = beside(
+            density, sigma, chi, q, beta, np.mean([c[0][0] for c in curves]), time,
+            out_dir.name == QUICK_FOLDER)
         exact, exact_error = block_means(exact_ratios)
-        off, off_error = ratio / exact - 1.0, np.hypot(error / exact,
-                                                       ratio * exact_error / exact**2)
-        start = np.argmax(window)  # Haff's law from the first snapshot of the cooling state
-        frequency = enskog_collision_frequency(n, sigma, chi, translational[start])
-        haff = rough_disk_haff_temperature(time[start:] - time[start],
-                                           translational[start] / translational[0], frequency,
-                                           RESTITUTION, beta, q)
-        # each run's T_tr(end)/T_tr(0) against DSMC's and Haff's
-        cooled = np.array([c[0][-1] / c[0][0] for c in curves])
-        at_end = [(np.mean(cooled) / reference - 1.0, np.std(cooled, ddof=1) / np.sqrt(
-            cooled.size) / reference) for reference in (exact_tr[-1] / exact_tr[0], haff[-1])]
+        off, off_error = relative_difference(ratio, error, exact, exact_error)
+        # each run's T_tr at the end: over its start against DSMC's, and against Haff's law
+        # from its own T_tr at the first snapshot of the cooling state
+        start = np.argmax(window)
+        haff = np.array([rough_disk_haff_temperature(
+            t[start:] - t[start], c[0][start],
+            enskog_collision_frequency(density, sigma, chi, c[0][start]), RESTITUTION, beta, q)
+            for c, t in zip(curves, times, strict=True)])
+        to_dsmc = relative_difference(*block_means([c[0][-1] / c[0][0] for c in curves]),
+                                      *block_means(exact_cooled))
+        to_haff = relative_difference(*block_means(np.array([c[0][-1] for c in curves])
+                                                  / haff[:, -1]),
+                                      1.0)
         rows.append((beta, exact, exact_error, theory, ratio, error, off, off_error,
-                     ratio / theory - 1.0, error / theory, len(ratios), *at_end[0],
-                     *at_end[1]))
+                     ratio / theory - 1.0, error / theory, len(ratios), *to_dsmc, *to_haff))
+        translational, rotational = np.mean(curves, axis=0)
         left.plot(per_disk, rotational / translational, color=f"C{k}",
                   label=f"β = {beta:g}: {ratio:.3f} ± {error:.3f}, /DSMC − 1 = "
                         f"{off:+.3f} ± {off_error:.3f}")
         left.plot(exact_per_disk, exact_rot / exact_tr, color=f"C{k}", ls="--", lw=1.2)
         left.axhline(theory, color=f"C{k}", ls=":", lw=1.2)
         right.semilogy(time, translational / translational[0], color=f"C{k}", lw=4, alpha=0.4,
-                       label=f"β = {beta:g}: at the end /DSMC − 1 = {at_end[0][0]:+.3f} ± "
-                             f"{at_end[0][1]:.3f}, /Haff − 1 = {at_end[1][0]:+.3f} ± "
-                             f"{at_end[1][1]:.3f}")
+                       label=f"β = {beta:g}: at the end /DSMC − 1 = {to_dsmc[0]:+.3f} ± "
+                             f"{to_dsmc[1]:.3f}, /Haff − 1 = {to_haff[0]:+.3f} ± "
+                             f"{to_haff[1]:.3f}")
         right.semilogy(time, exact_tr / exact_tr[0], color=f"C{k}", ls="--", lw=1.2)
-        right.semilogy(time[start:], haff, color="k", ls=":", lw=1.2)
+        right.semilogy(time[start:], haff.mean(axis=0) / translational[0], color="k", ls=":",
+                       lw=1.2)
     left.axvspan(*WINDOW, color="0.9", zorder=0, label="averaged (cooling state)")
     left.set(xlabel="collisions per disk", ylabel="T_rot / T_tr")
     left.set_title(f"ξ = {RESTITUTION}, q = {q}, N = {n}, φ = {phi:.3g}, {ds.sizes['seed']} "
