@@ -4,6 +4,7 @@ that figure 10 rests on."""
 
 import numpy as np
 import pytest
+import xarray as xr
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -13,6 +14,7 @@ from sim.analysis.crater import (
     calibrated_spacing,
     crater_area,
     occupied_cells,
+    require_stop,
 )
 from sim.analysis.datasets import open_run
 from sim.engine import Engine
@@ -111,3 +113,14 @@ def test_the_area_of_a_run_in_one_call(tmp_path):
         assert "melted" in ds.attrs["preparation"]
     assert area(path) == geometry.area(last)
     assert area(path, dx=geometry.dx / 2) == geometry.area(last, geometry.dx / 2)
+
+
+@pytest.mark.parametrize("order", [("projectile_speed", "seed"), ("seed", "projectile_speed")])
+def test_a_run_stopped_otherwise_names_its_swept_value_over_every_seed(order):
+    reasons = np.array([["at_rest", "at_rest"], ["at_rest", "time"], ["at_rest", "at_rest"]])
+    sweep = xr.Dataset({"stop_reason": (("projectile_speed", "seed"), reasons)},
+                       coords={"projectile_speed": [1.0, 2.0, 4.0], "seed": [0, 1]})
+    sweep = sweep.transpose(*order)
+    with pytest.raises(ValueError, match=r"projectile_speed = \[2\.0\] stopped otherwise"):
+        require_stop(sweep, "projectile_speed", "at_rest", "raise stop.time")
+    require_stop(sweep.sel(projectile_speed=[1.0, 4.0]), "projectile_speed", "at_rest", "")
