@@ -23,7 +23,7 @@ from sim.pipeline.overrides import CONF_DIR
 from variants import compose_scene
 
 EFFECT_MODULES = sorted(p.stem for p in Path(sim.effects.__file__).parent.glob("*.py")
-                        if p.stem not in ("__init__", "rules"))
+                        if p.stem not in ("__init__", "rules", "values"))  # helpers
 TESTS = Path(__file__).parent
 PROTOCOL = ("check_config", "engine_arguments", "loop_values")
 

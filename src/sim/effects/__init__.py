@@ -14,7 +14,7 @@ The protocol: every effect module defines
 ``KEYWORDS``
     {keyword of :class:`sim.engine.core.Engine`: (default, meaning)} — the keywords it takes;
 ``check_config(cfg)``
-    raise :class:`sim.pipeline.input_checks.ConfigError` for a bad value of its config keys;
+    raise :class:`sim.effects.values.ConfigError` for a bad value of its config keys;
 ``engine_arguments(cfg)``
     its keywords from a validated config, {keyword: value};
 ``loop_values(keywords, context)``

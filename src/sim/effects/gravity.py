@@ -27,9 +27,9 @@ from numba import types
 from numba.extending import overload
 
 from sim.effects.rules import effect_rule
+from sim.effects.values import ConfigError
 from sim.engine.inputs import refused, shaped_reals
 from sim.engine.kinematics import VX, shell_exit_time, shell_exit_time_accelerated
-from sim.pipeline.input_checks import ConfigError
 
 KEYWORDS = {"gravity": (None, "[gx, gy] uniform acceleration, two finite numbers "
                               "(:mod:`sim.effects.gravity`), zero along a periodic axis; None "

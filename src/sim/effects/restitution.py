@@ -22,9 +22,9 @@ import numpy as np
 
 from sim.effects.rotation import dissipates
 from sim.effects.rules import effect_rule
+from sim.effects.values import within
 from sim.engine.inputs import real_number, refused, shaped_reals, whole_count
 from sim.engine.parameters import per_disk
-from sim.pipeline.input_checks import within
 
 KEYWORDS = {
     "restitution": (None, "scalar or (s, s) symmetric normal restitution ξ per species pair, in "

@@ -52,14 +52,13 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from omegaconf import OmegaConf
 
 from sim.effects.pressure_tensor import observed
 from sim.effects.rules import effect_rule
 from sim.effects.thermal_walls import is_thermal, seed_value
+from sim.effects.values import ConfigError, positive, select, within
 from sim.engine.inputs import real_number, refused, shaped_reals
 from sim.engine.kinematics import RADIUS, VX, VY
-from sim.pipeline.input_checks import ConfigError, positive, within
 
 #: The tangential restitution of a smooth contact: no tangential impulse.
 SMOOTH = -1.0
@@ -117,8 +116,8 @@ def check_config(cfg):
     if cfg.box.boundary == "periodic":
         for key in ("restitution.wall_tangential", "friction.wall_mu"):
             default = SMOOTH if key.startswith("restitution") else None
-            if OmegaConf.select(cfg, key) != default:
-                raise ConfigError(key, OmegaConf.select(cfg, key),
+            if select(cfg, key) != default:
+                raise ConfigError(key, select(cfg, key),
                                   f"{default} in a periodic box, which has no walls")
     if rough and cfg.observe.pressure_tensor:
         raise ConfigError("observe.pressure_tensor", True, "false with rough disks (the "

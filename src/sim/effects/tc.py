@@ -16,8 +16,8 @@ floor under gravity leaves it as from a bounce lasting t_c
 import math
 
 from sim.effects.rules import effect_rule
+from sim.effects.values import positive
 from sim.engine.inputs import real_number
-from sim.pipeline.input_checks import positive
 
 KEYWORDS = {"tc": (None, "TC-model time t_c, finite and ≥ 0 (None or 0 = off)")}
 

@@ -18,10 +18,10 @@ import numpy as np
 from numba import njit
 
 from sim.effects.rules import effect_rule
+from sim.effects.values import positive, walled
 from sim.engine.box import WALL_NAMES
 from sim.engine.inputs import WALLS, wall_keyword, whole_count
 from sim.engine.kinematics import INF, VX
-from sim.pipeline.input_checks import positive, walled
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX_1 = np.uint64(0xBF58476D1CE4E5B9)

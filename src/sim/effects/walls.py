@@ -23,6 +23,7 @@ from numba.extending import overload
 from sim.effects.gravity import acceleration, resting_lift
 from sim.effects.rules import effect_rule
 from sim.effects.thermal_walls import thermal_redraw
+from sim.effects.values import ConfigError, positive, walled
 from sim.engine.box import SIDE, WALL_NAMES
 from sim.engine.inputs import WALLS, wall_keyword
 from sim.engine.kinematics import (
@@ -34,7 +35,6 @@ from sim.engine.kinematics import (
     first_contact_oscillating,
     wall_contact_time,
 )
-from sim.pipeline.input_checks import ConfigError, positive, walled
 
 #: A piston (a wall moving at constant speed) that has raised the kinetic energy this many
 #: times above max(initial energy, N m U²) has jammed the disks against the opposite wall:

@@ -17,10 +17,7 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import DictConfig, OmegaConf
 
 from sim.effects import check_config
-from sim.engine.inputs import MAX_COUNT
-from sim.pipeline.config_reference import leaves
-from sim.pipeline.initial import RSA_JAMMING
-from sim.pipeline.input_checks import (
+from sim.effects.values import (
     LARGEST,
     MAX_DISKS,
     MAX_SEED,
@@ -30,6 +27,9 @@ from sim.pipeline.input_checks import (
     resolvable,
     within,
 )
+from sim.engine.inputs import MAX_COUNT
+from sim.pipeline.config_reference import leaves
+from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.scenes import SCENES
 from sim.pipeline.schema import RENAMED_KEYS, SimConfig, leaf_fields, plain_type
 

@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
+from sim.effects.values import MAX_DISKS
 from sim.engine.inputs import (
     box_sides,
     periodic_pair,
@@ -32,7 +33,6 @@ from sim.engine.inputs import (
     refused,
     whole_count,
 )
-from sim.pipeline.input_checks import MAX_DISKS
 
 RSA_JAMMING = 0.547
 

@@ -17,6 +17,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from sim.effects.values import MAX_DISKS, ConfigError, pair, positive, resolvable, within
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
@@ -31,7 +32,6 @@ from sim.pipeline.initial import (
     random_sequential,
     remove_drift,
 )
-from sim.pipeline.input_checks import MAX_DISKS, ConfigError, pair, positive, resolvable, within
 
 
 @dataclass

@@ -1,9 +1,10 @@
 """What a config value may be: :class:`ConfigError`, the limits of the engine's numbers, and
 the checks that :func:`sim.pipeline.config.validate`, the effects' (:mod:`sim.effects`) and
-the scenes' own checks (:mod:`sim.pipeline.scenes`) share."""
+the scenes' own checks (:mod:`sim.pipeline.scenes`) share. A leaf below the effects and the
+pipeline: it reads a config (an OmegaConf DictConfig or any object with the same attributes)
+without importing OmegaConf, so that the engine and the effects load without it."""
 
 import numpy as np
-from omegaconf import OmegaConf
 
 from sim.engine.inputs import RESOLUTION_LIMIT, SCALE_LIMIT
 
@@ -61,16 +62,33 @@ def resolvable(c, key, radius, value=None):
                           f"{radius:.3g}): float64 positions resolve 2^-52 of the side")
 
 
+def select(c, key):
+    """The config value at the dotted ``key`` (``"box.size"``)."""
+    for name in key.split("."):
+        c = getattr(c, name)
+    return c
+
+
+def plain(value):
+    """A config value as plain Python: lists and mappings of a DictConfig (or of a plain
+    config) as lists and dicts, for messages and arrays."""
+    if isinstance(value, str) or not hasattr(value, "__iter__"):
+        return value
+    if hasattr(value, "keys"):
+        return {k: plain(value[k]) for k in value.keys()}
+    return [plain(v) for v in value]
+
+
 def walled(c, name):
     """Refuse a thermal or moving wall ``walls.<name>`` in a periodic box."""
     if c.box.boundary == "periodic":
-        raise ConfigError(f"walls.{name}", OmegaConf.to_container(c.walls[name]),
+        raise ConfigError(f"walls.{name}", plain(c.walls[name]),
                           "thermal or moving walls need box.boundary=walls")
 
 
 def pair(c, key, allowed):
     """The config list at ``key`` as float64[2, 2], or :class:`ConfigError` naming it."""
-    value = OmegaConf.to_container(OmegaConf.select(c, key))
+    value = plain(select(c, key))
     try:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
