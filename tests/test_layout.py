@@ -1,16 +1,22 @@
-"""The layout: the engine and the effects stand below the pipeline, and every old import path
-(the flat package, the run helpers once in sim.figures) still leads to its module, with a
-DeprecationWarning, and ``python -m`` on an old path runs the new module."""
+"""The layout: no import circle among sim's modules, the engine and the effects below the
+pipeline, and every old import path (the flat package, the run helpers once in sim.figures)
+still leads to its module, with a DeprecationWarning, and ``python -m`` on an old path runs
+the new module."""
 
+import ast
 import importlib
 import pkgutil
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
+import sim
 import sim.effects
 import sim.engine
 from sim.moved import MOVED
+
+SOURCE = Path(sim.__file__).parent
 
 #: what the engine and the effects must not load: the config machinery and the layers above
 ABOVE = ("omegaconf", "hydra", "sim.pipeline", "sim.storage", "sim.analysis", "sim.checks",
@@ -45,3 +51,40 @@ def test_an_old_command_path_runs():
     out = subprocess.run([sys.executable, "-m", "sim.inspect", "--help"], capture_output=True,
                          text=True, check=True)
     assert out.stdout.startswith("usage: sim-inspect")
+
+
+def imports_among_modules():
+    """sim's modules and, for each, the modules of sim it imports anywhere in its source (a
+    name imported from a module counts as that module, or as the submodule of that name)."""
+    modules = {}
+    for path in SOURCE.rglob("*.py"):
+        parts = ("sim", *path.relative_to(SOURCE).with_suffix("").parts)
+        modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    graph = {name: set() for name in modules}
+    for name, path in modules.items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                graph[name] |= {a.name for a in node.names if a.name in modules}
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                for alias in node.names:
+                    full = f"{node.module}.{alias.name}"
+                    target = full if full in modules else node.module
+                    if target in modules:
+                        graph[name].add(target)
+    return graph
+
+
+def test_no_module_of_sim_imports_itself_back():
+    graph = imports_among_modules()
+    circles = []
+    for start in graph:  # a path from a module back to itself, by depth-first search
+        stack, seen = [(start, (start,))], set()
+        while stack:
+            name, path = stack.pop()
+            for imported in graph[name]:
+                if imported == start:
+                    circles.append(" → ".join((*path, start)))
+                elif imported not in seen:
+                    seen.add(imported)
+                    stack.append((imported, (*path, imported)))
+    assert len(graph) > 100 and not circles, circles

@@ -6,6 +6,8 @@ inside a guard, so that Ctrl-C or SIGTERM while the engine and Hydra load ends w
 import os  # os and sys are loaded with the interpreter: importing them costs nothing
 import sys
 
+from sim.pipeline.leaving import caused_by_a_signal, leave
+
 #: the signal that arrived while the command line was loading (2: SIGINT, 15: SIGTERM)
 _ARRIVED = [2]
 #: the flags that print the reference of every scenario and key
@@ -15,25 +17,6 @@ HELP = ("-h", "--help")
 def _stop(signum, frame):
     _ARRIVED.append(signum)
     raise KeyboardInterrupt
-
-
-def caused_by_a_signal(error):
-    """Whether a KeyboardInterrupt is ``error`` or its cause (Python wraps one raised while
-    a class is being made, e.g. in ``__set_name__``)."""
-    while error is not None:
-        if isinstance(error, KeyboardInterrupt):
-            return True
-        error = error.__cause__ or error.__context__
-    return False
-
-
-def leave(message, status):
-    """Print ``message`` and end the process with ``status`` at once. After a Ctrl-C that
-    landed in code run by ``exec`` (dataclasses make their methods so), CPython would end
-    an orderly exit by killing itself with SIGINT instead; nothing is left to clean up."""
-    print(message, file=sys.stderr, flush=True)
-    sys.stdout.flush()
-    os._exit(status)
 
 
 def _help():

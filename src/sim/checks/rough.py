@@ -23,6 +23,7 @@ from sim.analysis.theory import (
     rough_disk_temperature_ratio,
 )
 from sim.checks import dsmc
+from sim.checks.gases import equilibrated_gas
 from sim.checks.rows import Check, block_means
 from sim.effects.rotation import moment_of_inertia
 from sim.engine.core import Engine
@@ -42,11 +43,9 @@ def _temperatures(engine, cells):
 
 
 def _rough_gas(n, phi, seed, rotational_ratio, **effects):
-    """The equilibrated elastic gas (:func:`sim.checks.validation.equilibrated_gas`, 10
+    """The equilibrated elastic gas (:func:`sim.checks.gases.equilibrated_gas`, 10
     collisions per disk) continued as rough disks with spins Maxwellian at T_rot =
     ``rotational_ratio`` T_tr."""
-    from sim.checks.validation import equilibrated_gas  # that module lists these studies
-
     elastic, radius = equilibrated_gas(n, phi, 10, seed)
     temperature = elastic.kinetic_energy() / (n - 1)
     engine = Engine(elastic.positions(), elastic.velocities(), radius, elastic.mass,

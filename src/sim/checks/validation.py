@@ -27,13 +27,13 @@ from sim.analysis.theory import (
     kolafa_rottner_z,
 )
 from sim.checks import dsmc
+from sim.checks.gases import cooling_gas, equilibrated_gas
 from sim.checks.rough import rough_cooling, rough_equipartition
 from sim.checks.rows import Check, block_means, ratio_of_means
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
     fixed_speed,
-    hexagonal_lattice,
     maxwellian,
     radius_for_packing,
     random_sequential,
@@ -41,23 +41,6 @@ from sim.pipeline.initial import (
 )
 
 # -- equilibrium hard-disk fluid --------------------------------------------------------------
-
-def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None):
-    """Elastic equal-size disks in the periodic unit box at T = 1 with zero total momentum,
-    run ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
-    radius = radius_for_packing(n, phi)
-    periodic = (True, True)
-    mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,))
-    if phi > 0.3:
-        position = hexagonal_lattice(n, radius, periodic=periodic, seed=seed)
-    else:
-        position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
-    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
-    engine = Engine(position, velocity, radius, mass, species,
-                    boundary=Boundary(periodic=periodic))
-    engine.run(collisions=int(collisions_per_disk * n))
-    return engine, radius
-
 
 def virial_blocks(engine, blocks, collisions_per_block):
     """Run an elastic engine on in ``blocks`` consecutive blocks of ``collisions_per_block``
@@ -137,15 +120,6 @@ def maxwell_boltzmann(n=4000, phi=0.3, warmup=20, snapshots=5, apart=10, seed=3)
 
 
 # -- granular gases ---------------------------------------------------------------------------
-
-def cooling_gas(n, phi, restitution, seed, tc=None, mass=1.0, species=None):
-    """A homogeneous granular gas at T = 1: the equilibrated elastic gas (10 collisions per
-    disk) continued with restitution ξ."""
-    elastic, radius = equilibrated_gas(n, phi, 10, seed, mass, species)
-    engine = Engine(elastic.positions(), elastic.velocities(), radius, elastic.mass, species,
-                    boundary=elastic.boundary, restitution=restitution, tc=tc)
-    return engine, radius
-
 
 def haff_cooling(restitution, n=2000, phi=0.005, seed=5, runs=32, cells=4,
                  dsmc_particles=10000, dsmc_runs=32):

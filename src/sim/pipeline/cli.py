@@ -37,7 +37,6 @@ from hydra.core.hydra_config import HydraConfig
 from hydra.types import RunMode
 from omegaconf import OmegaConf
 
-from sim.__main__ import leave
 from sim.engine.errors import PhysicsBreakdown
 from sim.pipeline import callbacks, cli_exits, sweep_stop
 from sim.pipeline.cli_exits import (
@@ -58,6 +57,7 @@ from sim.pipeline.cli_exits import (
 )
 from sim.pipeline.config import ConfigError, register
 from sim.pipeline.interruption import Interruption
+from sim.pipeline.leaving import leave
 from sim.pipeline.overrides import (
     CONF_DIR,
     SWEEP_FLAGS,

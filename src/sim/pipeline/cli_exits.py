@@ -6,7 +6,7 @@ import os
 import signal
 import sys
 
-from sim.__main__ import leave
+from sim.pipeline.leaving import leave
 from sim.storage.h5md import hdf5_reason
 
 EXIT_BAD_CONFIG = 2

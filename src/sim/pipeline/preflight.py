@@ -9,10 +9,10 @@ from pathlib import Path
 from omegaconf import OmegaConf
 from omegaconf.errors import KeyValidationError, ValidationError
 
-from sim.__main__ import caused_by_a_signal
 from sim.pipeline import cli_exits, resources, sweep_stop
 from sim.pipeline.cli_exits import EXIT_RUN_FILE, fail, first_line, make_folder
 from sim.pipeline.config import ConfigError, validate
+from sim.pipeline.leaving import caused_by_a_signal
 from sim.pipeline.overrides import (
     CONF_DIR,
     SWEEP_FLAGS,

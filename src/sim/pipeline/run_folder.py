@@ -31,6 +31,7 @@ from pathlib import Path
 from sim.pipeline.config import ConfigError
 from sim.storage.errors import RunFileError
 from sim.storage.h5md import hdf5_reason
+from sim.storage.run_lock import lock_path
 
 #: flock's errors on a file system that has no file locks (some Lustre and NFS mounts)
 NO_LOCKS = (errno.ENOLCK, errno.ENOSYS, errno.EOPNOTSUPP)
@@ -58,12 +59,6 @@ def new_folder(base):
         except FileExistsError:
             continue
     raise FileExistsError(errno.EEXIST, f"no free folder name next to {base}")
-
-
-def lock_path(path):
-    """The lock file of the run file ``path``: beside the file its links lead to."""
-    real = Path(os.path.realpath(path))
-    return real.with_name(f".{real.name}.lock")
 
 
 #: Whether HDF5 locks the files it opens. ``HDF5_USE_FILE_LOCKING`` set to ``FALSE`` or ``0``
@@ -95,27 +90,6 @@ def held(path):
             if error.errno not in NO_LOCKS:
                 raise
         yield
-    finally:
-        os.close(fd)
-
-
-def writer_of(path):
-    """Who holds the lock of the run file ``path`` (``process N``, or ``another process``),
-    or None when no run does: a shared ``flock`` of its lock file, asked without waiting and
-    let go at once. Readers ask it where HDF5's own locks may be off."""
-    try:
-        fd = os.open(lock_path(path), os.O_RDONLY)
-    except OSError:  # no lock file: no run
-        return None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-        fcntl.flock(fd, fcntl.LOCK_UN)
-        return None
-    except BlockingIOError:
-        pid = os.read(fd, 32).decode(errors="replace").strip()
-        return f"process {pid}" if pid else "another process"
-    except OSError:  # a file system without locks: none to ask
-        return None
     finally:
         os.close(fd)
 

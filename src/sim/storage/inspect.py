@@ -21,6 +21,7 @@ import numpy as np
 import yaml
 
 from sim.storage.errors import RunFileError
+from sim.storage.run_lock import writer_of  # the run's own lock: HDF5's may be off
 
 #: what a read of a damaged run file raises: h5py's errors, and HDF5's for broken metadata
 DAMAGE = (KeyError, OSError, RuntimeError, ValueError)
@@ -321,7 +322,6 @@ def main(argv=None):
     parser.add_argument("path", help="run file (run.h5)")
     parser.add_argument("--json", action="store_true", help="one JSON object")
     args = parser.parse_args(argv)
-    from sim.pipeline.run_folder import writer_of  # the run's own lock: HDF5's may be off
 
     writer = writer_of(args.path)
     if writer is not None:
