@@ -1,7 +1,8 @@
 """One word, one meaning: a *contact* is a disk touching a disk (a *collision*) or a wall (a
 *wall contact*); an *event* is what the loop applies, a contact or a neighbour-shell exit
-(:mod:`sim.engine.codes`). The names these words replaced still work for one release, with a
-warning, and run files written before the renaming still open and resume."""
+(:mod:`sim.engine.codes`). The names these words replaced in 0.1.0 are gone; a run file of
+0.1.0, whose config still holds the old stop key (null), resumes to the same bits, and one of
+an older sim is refused in one line."""
 
 import h5py
 import numpy as np
@@ -11,7 +12,7 @@ import yaml
 from sim.analysis.datasets import open_run
 from sim.engine import Engine
 from sim.pipeline import runner
-from sim.pipeline.config import register, renamed_keys
+from sim.pipeline.config import ConfigError, register
 from sim.pipeline.initial import fixed_speed, radius_for_packing, random_sequential
 from sim.pipeline.overrides import compose_overrides
 from sim.pipeline.resume import resume
@@ -37,15 +38,9 @@ def test_contacts_are_collisions_and_wall_contacts_and_events_are_more(gas):
     assert gas.contacts_by_disk().sum() == 2 * gas.collisions + gas.wall_contacts
 
 
-@pytest.mark.parametrize("old, new", [("steps", "events"), ("wall_collisions", "wall_contacts")])
-def test_old_engine_names_warn_and_read_the_new(gas, old, new):
-    with pytest.warns(DeprecationWarning, match=f"Engine.{old} is now Engine.{new}"):
-        assert getattr(gas, old) == getattr(gas, new)
-
-
-def test_collisions_by_disk_is_contacts_by_disk(gas):
-    with pytest.warns(DeprecationWarning, match="contacts_by_disk"):
-        np.testing.assert_array_equal(gas.collisions_by_disk(), gas.contacts_by_disk())
+@pytest.mark.parametrize("old", ["steps", "wall_collisions", "collisions_by_disk"])
+def test_the_names_before_the_renaming_are_gone(gas, old):
+    assert not hasattr(gas, old)
 
 
 @pytest.mark.parametrize("stop", ["contacts", "collisions", "events"])
@@ -59,44 +54,30 @@ def test_each_count_stops_a_run_exactly(stop):
     assert getattr(engine, stop) == target
 
 
-def test_the_old_stop_key_warns_and_sets_the_new():
-    with pytest.warns(FutureWarning, match=r"stop.events=70 is now called stop.contacts=70"):
-        cfg = compose_overrides(["scenario=single_disk", "stop.events=70"])
-    assert (cfg.stop.contacts, cfg.stop.events) == (70, None)
-
-
-def _as_written_before_the_renaming(path):
-    """Give the run file at ``path`` the names a run file had before the renaming."""
+def _stored_stop(path, **stop):
+    """Set keys of the stop section of the config stored in the run file at ``path``."""
     with h5py.File(path, "r+") as f:
-        f["observables"].move("wall_contacts", "wall_collisions")
         parameters = f["parameters"].attrs
         config = yaml.safe_load(str(parameters["config"]))
-        config["stop"]["events"] = config["stop"].pop("contacts")
+        config["stop"].update(stop)
         parameters["config"] = yaml.safe_dump(config)
-        parameters["stop_reason"] = "events"
 
 
-def test_a_run_file_from_before_the_renaming_opens_and_resumes(tmp_path):
-    cfg = compose_overrides(["scenario=single_disk", "stop.contacts=200",
-                             "output.progress=false"])
-    path = runner.run(cfg, tmp_path)
-    with open_run(path) as ds:
-        written = ds["wall_contacts"].values.copy()
-    _as_written_before_the_renaming(path)
-    with open_run(path) as ds:
-        np.testing.assert_array_equal(ds["wall_contacts"].values, written)
-    assert resume(path) == path  # complete as it was: nothing to do, nothing written
-    assert summary(path)["stop_reason"] == "events"
+def test_a_run_file_of_version_0_1_0_resumes_to_the_same_bits(tmp_path):
+    overrides = ["scenario=single_disk", "output.progress=false"]
+    whole = runner.run(compose_overrides([*overrides, "stop.contacts=300"]), tmp_path / "whole")
+    path = runner.run(compose_overrides([*overrides, "stop.contacts=200"]), tmp_path / "part")
+    _stored_stop(path, events=None)  # 0.1.0 stored the renamed key, null
     resume(path, ["stop.contacts=300"])
-    with h5py.File(path, "r") as f:
-        assert "wall_contacts" in f["observables"] and "wall_collisions" not in f["observables"]
-        assert f["observables/wall_contacts/value"][-1] == 300
-        config = yaml.safe_load(str(f["parameters"].attrs["config"]))
-    assert (config["stop"]["contacts"], config["stop"]["events"]) == (300, None)
+    with open_run(path) as resumed, open_run(whole) as ds:
+        np.testing.assert_array_equal(resumed["position"].values[-1], ds["position"].values[-1])
+        assert int(resumed["wall_contacts"].values[-1]) == 300
     assert summary(path)["stop_reason"] == "contacts"
 
 
-def test_renamed_keys_leave_a_config_with_new_names_alone():
-    cfg = compose_overrides(["scenario=single_disk"])
-    before = cfg.copy()
-    assert renamed_keys(cfg) == before
+def test_a_run_file_of_an_older_sim_is_refused_in_one_line(tmp_path):
+    path = runner.run(compose_overrides(["scenario=single_disk", "stop.contacts=50",
+                                         "output.progress=false"]), tmp_path)
+    _stored_stop(path, events=50, contacts=None)
+    with pytest.raises(ConfigError, match=r"stop.events=50, the name before 0.1.0"):
+        resume(path, ["stop.contacts=80"])

@@ -44,8 +44,3 @@ def _numba_cache_dir():
 
 if "NUMBA_CACHE_DIR" not in os.environ:
     os.environ["NUMBA_CACHE_DIR"] = _numba_cache_dir()
-
-
-from sim.moved import install as _install_moved  # noqa: E402  (old import paths, one release)
-
-_install_moved()

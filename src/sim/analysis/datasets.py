@@ -37,7 +37,6 @@ from sim.storage.errors import RunFileError
 from sim.storage.h5md import (
     OBSERVABLES,
     PARTICLE_SERIES,
-    RENAMED_OBSERVABLES,
     SPIN_OBSERVABLES,
 )
 from sim.storage.inspect import (
@@ -125,8 +124,7 @@ def open_run(path):
                                       _H5Array(disks[f"{name}/value"], time, path)))
                 for name in PARTICLE_SERIES if name in disks}
         axes, damaged = {}, []
-        for stored, group in f["observables"].items():
-            name = RENAMED_OBSERVABLES.get(stored, stored)
+        for name, group in f["observables"].items():
             if name.endswith("by_species"):
                 dims = ("time", "species")
             elif name in OBSERVABLES or name in SPIN_OBSERVABLES:

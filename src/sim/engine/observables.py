@@ -2,7 +2,6 @@
 user's numbering of the disks, and the contacts its event log kept (:class:`Observables`, a
 part of :class:`sim.engine.core.Engine`)."""
 
-import warnings
 
 import numpy as np
 
@@ -12,17 +11,6 @@ from sim.effects.rotation import moment_of_inertia, rotational_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
-
-
-def renamed(old, new):
-    """The attribute ``old``, read as ``new`` with a DeprecationWarning (kept for one
-    release after the renaming)."""
-
-    def read(self):
-        warnings.warn(f"Engine.{old} is now Engine.{new}", DeprecationWarning, stacklevel=2)
-        return getattr(self, new)
-
-    return property(read, doc=f"Deprecated name of :attr:`{new}`.")
 
 
 class Observables:
@@ -53,9 +41,6 @@ class Observables:
         """Events the engine applied so far: contacts and neighbour-shell exits (the words
         of :mod:`sim.engine.codes`)."""
         return int(self.counters[codes.EVENTS])
-
-    steps = renamed("steps", "events")
-    wall_collisions = renamed("wall_collisions", "wall_contacts")
 
     @property
     def dissipated_energy(self):
@@ -111,8 +96,6 @@ class Observables:
         """Contacts (disk and wall) of each disk so far: int64[n]."""
         loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
         return self._user_order(self.disks.contacts)
-
-    collisions_by_disk = renamed("collisions_by_disk", "contacts_by_disk")
 
     def next_event_time(self):
         """Absolute time of the next scheduled event (possibly stale)."""

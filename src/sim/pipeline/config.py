@@ -10,7 +10,6 @@ checks of each scene's own keys, are :data:`sim.pipeline.scenes.SCENES`.
 """
 
 import math
-import warnings
 from typing import Any
 
 from hydra.core.config_store import ConfigStore
@@ -31,25 +30,7 @@ from sim.engine.inputs import MAX_COUNT
 from sim.pipeline.config_reference import leaves
 from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.scenes import SCENES
-from sim.pipeline.schema import RENAMED_KEYS, SimConfig, leaf_fields, plain_type
-
-
-def renamed_keys(cfg, warn=True):
-    """Move the values of ``cfg`` (a DictConfig, changed in place) given under an old name of
-    :data:`RENAMED_KEYS` to the new name, where they replace any value (the shipped YAML
-    uses the new names only, so an old name was given on purpose); returns ``cfg``.
-    ``warn``: say so (a FutureWarning); off for the configs stored in run files written
-    before the renaming."""
-    for old, new in RENAMED_KEYS.items():
-        value = OmegaConf.select(cfg, old)
-        if value is None:
-            continue
-        if warn:
-            warnings.warn(f"{old}={value} is now called {new}={value} (the old name goes in "
-                          f"the next release)", FutureWarning, stacklevel=1)  # said once
-        OmegaConf.update(cfg, new, value)
-        OmegaConf.update(cfg, old, None)
-    return cfg
+from sim.pipeline.schema import SimConfig, leaf_fields, plain_type
 
 
 def register():

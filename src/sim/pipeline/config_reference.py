@@ -31,7 +31,7 @@ from pathlib import Path
 
 import yaml
 
-from sim.pipeline.schema import CONF_DIR, RENAMED_KEYS, SimConfig, leaf_fields, plain_type
+from sim.pipeline.schema import CONF_DIR, SimConfig, leaf_fields, plain_type
 
 CONF = Path(CONF_DIR)
 #: keys set by the scenario files, not by hand (``scenario=NAME`` chooses them)
@@ -197,11 +197,11 @@ def _kind(annotation):
 
 
 def schema_keys():
-    """{dotted key: (type, default)} of every leaf of the schema, old names and the keys set
-    by the scenario files aside."""
+    """{dotted key: (type, default)} of every leaf of the schema, the keys set by the scenario
+    files aside."""
     return {key: (_kind(f.type), f.default_factory() if f.default is MISSING else f.default)
             for key, f in leaf_fields()
-            if key not in RENAMED_KEYS and key not in SET_BY_SCENARIO}
+            if key not in SET_BY_SCENARIO}
 
 
 def scene_sections():

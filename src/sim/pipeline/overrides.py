@@ -11,7 +11,7 @@ from hydra import compose, initialize_config_dir
 from hydra.core.override_parser.overrides_parser import OverridesParser
 
 from sim.pipeline.cli_exits import fail, first_line
-from sim.pipeline.config import integer_keys, renamed_keys
+from sim.pipeline.config import integer_keys
 from sim.pipeline.schema import CONF_DIR
 
 INTEGER_KEYS = frozenset(integer_keys())
@@ -134,8 +134,7 @@ def _unreadable(overrides, error):
 def compose_overrides(combination, hydra_config=False):
     """The config of ``combination`` (with Hydra's own node when ``hydra_config``)."""
     with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
-        return renamed_keys(compose("config", overrides=list(combination),
-                                    return_hydra_config=hydra_config))
+        return compose("config", overrides=list(combination), return_hydra_config=hydra_config)
 
 
 def hydra_settings(args):

@@ -18,7 +18,7 @@ from omegaconf.errors import ValidationError
 
 from sim.analysis.observers import from_config as observers_from_config
 from sim.pipeline import resources
-from sim.pipeline.config import ConfigError, SimConfig, flat, renamed_keys, validate
+from sim.pipeline.config import ConfigError, SimConfig, flat, validate
 from sim.pipeline.engine_from_config import build_engine
 from sim.pipeline.run_folder import locked
 from sim.pipeline.snapshots import advance, next_snapshot_time
@@ -31,11 +31,14 @@ from sim.storage.inspect import open_run_file
 log = logging.getLogger(__name__)
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
-FINISHED = ("collisions", "contacts", "time", "energy_fraction", "at_rest", "no_events",
-            "events")  # "events": the contact stop of run files before its renaming
+FINISHED = ("collisions", "contacts", "time", "energy_fraction", "at_rest", "no_events")
+
+#: The stop key that sim 0.1.0 renamed (stop.contacts now) and still stored, always null:
+#: dropped from the configs of its run files, refused when set (a run file of an older sim)
+RENAMED_STOP = "events"
 
 #: Keys a resume may change: when the run stops, how often it writes, what it shows.
-RESUMABLE = ("stop.collisions", "stop.contacts", "stop.events", "stop.time",
+RESUMABLE = ("stop.collisions", "stop.contacts", "stop.time",
              "stop.energy_fraction", "stop.at_rest", "stop.wall_seconds",
              "output.every_collisions", "output.every_time", "output.progress")
 
@@ -99,8 +102,10 @@ def stored_config(path, key="resume"):
         with open_run_file(path) as f:
             attrs = f["parameters"].attrs
             text, reason = str(attrs["config"]), str(attrs["stop_reason"])
-        stored = renamed_keys(OmegaConf.merge(OmegaConf.structured(SimConfig),
-                                              OmegaConf.create(_literal(text))), warn=False)
+        given = _literal(text)
+        renamed = (given.get("stop") or {}).pop(RENAMED_STOP, None)
+        if renamed is None:
+            stored = OmegaConf.merge(OmegaConf.structured(SimConfig), OmegaConf.create(given))
     except RunFileError as error:
         raise ConfigError(key, str(path), f"a readable run file: {error}") from error
     except Exception as error:  # a damaged /parameters: h5py, YAML or schema errors
@@ -109,6 +114,10 @@ def stored_config(path, key="resume"):
         where = f"its stored {error.full_key}: " if getattr(error, "full_key", None) else ""
         raise ConfigError(key, str(path), f"a run file with its config intact: {where}"
                           f"{type(error).__name__}: {reason}") from error
+    if renamed is not None:
+        raise ConfigError(key, str(path), f"a run file of sim 0.1.0 or later: this one stops "
+                          f"by stop.{RENAMED_STOP}={renamed}, the name before 0.1.0 (resume it "
+                          f"with sim 0.1.0)")
     try:
         validate(stored)
     except (ConfigError, ValidationError) as error:  # a value edited in, read as it stands
@@ -224,7 +233,7 @@ def apply_overrides(stored, overrides):
         cfg.output.every_collisions = None  # a cadence in time replaces one in collisions
     if any(k == "output.every_collisions" for k in keys) and "output.every_time" not in keys:
         cfg.output.every_time = None
-    return renamed_keys(cfg)
+    return cfg
 
 
 def _repeats(stored, item):

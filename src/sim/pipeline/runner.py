@@ -24,7 +24,7 @@ from pathlib import Path
 from omegaconf import OmegaConf
 
 from sim.pipeline import resources
-from sim.pipeline.config import ConfigError, SimConfig, renamed_keys, validate
+from sim.pipeline.config import ConfigError, SimConfig, validate
 from sim.pipeline.engine_from_config import build_engine
 from sim.pipeline.interruption import Interruption
 from sim.pipeline.resume import (
@@ -53,7 +53,7 @@ log = logging.getLogger(__name__)
 def _as_config(cfg):
     if not OmegaConf.is_config(cfg):
         cfg = OmegaConf.structured(cfg if isinstance(cfg, SimConfig) else SimConfig(**cfg))
-    return renamed_keys(cfg)
+    return cfg
 
 
 def run(cfg, output_dir=".", overrides=(), folder_key="output_dir"):

@@ -1,5 +1,4 @@
-"""The schema of a scene's config: one dataclass per section of ``conf/config.yaml``, and the
-keys renamed in this release.
+"""The schema of a scene's config: one dataclass per section of ``conf/config.yaml``.
 
 It stands apart from the checks (:mod:`sim.pipeline.config`, which need the scenes and so the
 engine) so that the reference of the keys (:mod:`sim.pipeline.config_reference`, ``python -m
@@ -76,7 +75,6 @@ class TCConfig:
 class StopConfig:
     collisions: Optional[int] = None
     contacts: Optional[int] = None
-    events: Optional[int] = None  # the old name of contacts (RENAMED_KEYS)
     time: Optional[float] = None
     energy_fraction: Optional[float] = None
     at_rest: Optional[float] = None
@@ -177,9 +175,6 @@ class SimConfig:
     resume: Optional[str] = None
 
 
-#: Keys renamed in this release: old name → new name. The old name still works, with a
-#: FutureWarning, until the next release.
-RENAMED_KEYS = {"stop.events": "stop.contacts"}
 
 
 def plain_type(annotation):

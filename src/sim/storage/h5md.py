@@ -71,9 +71,6 @@ COUNTS = ("collisions", "wall_contacts")
 #: observables of a run whose disks turn (:mod:`sim.effects.rotation`)
 SPIN_OBSERVABLES = {"rotational_energy": ("energy", "Σ I ω²/2 over all disks")}
 
-#: observables of run files written before a renaming: old name → name now
-RENAMED_OBSERVABLES = {"wall_collisions": "wall_contacts"}
-
 
 def _time_series(group, shape, dtype, unit, description):
     """An H5MD time-dependent element: extensible step, time and value datasets. Every
@@ -164,10 +161,6 @@ class RunWriter:
             except BaseException:
                 self.abandon()  # a half-made file left open can crash HDF5 at exit
                 raise
-        else:
-            for old, new in RENAMED_OBSERVABLES.items():
-                if old in self.file["observables"]:
-                    self.file["observables"].move(old, new)
         self._flushed_frames = self.file["particles/disks/position/step"].shape[0]
         if engine.event_log is not None:
             engine.event_sink = self._log_contacts
