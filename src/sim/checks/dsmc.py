@@ -355,6 +355,19 @@ def at_collisions(gas, rule, n_particles, marks, seed, step=0.05, **initial):
     return np.array([r[0] for r in read]), np.array([r[1] for r in read])
 
 
+def cooled_in_haff_time(gas, rule, n_particles, cooling_rate, seed, **initial):
+    """T_tr(t₀)/T_tr(0) of species 0 at Haff's time t₀ = 2/(ν₀ ζ/ν), ν₀ Enskog's collision
+    frequency of species 0 at the start's T_tr(0) and ζ/ν = ``cooling_rate`` ((1 − ξ²)/2 for
+    smooth disks), where Haff's law gives 1/4. The start as :func:`run`'s."""
+    rng = np.random.default_rng(seed)
+    state = initial_state(gas, n_particles, rng, **initial)
+    start = temperatures(gas, state)[0][0]
+    t0 = 2.0 / (cooling_rate * enskog_collision_frequency(
+        gas.density, gas.diameters[0], gas.chi, start, gas.masses[0]))
+    series, _ = simulate(gas, rule, state, [t0], rng)
+    return series.translational[0, 0] / start
+
+
 class CoolingState(NamedTuple):
     """The homogeneous cooling state: r = T_rot/T_tr and ζ/ν (ν Enskog's at T_tr), each
     with its standard error; ``collisions_per_particle`` C/N simulated over all seeds."""

@@ -139,13 +139,8 @@ def rough_cooling(restitution, roughness, n=2000, phi=0.005, seed=71, runs=32, w
         translational, rotational = dsmc.at_collisions(gas, rule, dsmc_particles, marks,
                                                        seed + k, rotational_temperature=start)
         exact_ratios.append(np.mean(rotational[:, 0] / translational[:, 0]))
-        rng = np.random.default_rng(seed + k)
-        begin = dsmc.initial_state(gas, dsmc_particles, rng, rotational_temperature=start)
-        t_zero = dsmc.temperatures(gas, begin)[0][0]
-        t0 = 2.0 / (enskog_collision_frequency(gas.density, gas.diameters[0], gas.chi, t_zero)
-                    * rate)
-        series, _ = dsmc.simulate(gas, rule, begin, [t0], rng)
-        exact_decays.append(series.translational[0, 0] / t_zero)
+        exact_decays.append(dsmc.cooled_in_haff_time(gas, rule, dsmc_particles, rate, seed + k,
+                                                     rotational_temperature=start))
     (ratio, error), (decay, decay_error) = block_means(ratios), block_means(decays)
     (reference, reference_error), (exact_decay, exact_decay_error) = (
         block_means(exact_ratios), block_means(exact_decays))
