@@ -1,5 +1,5 @@
-"""The layout: no import circle among sim's modules, and the engine and the effects below the
-pipeline."""
+"""The layout: no import circle among sim's modules, the engine and the effects below the
+pipeline, and no long positional argument lists."""
 
 import ast
 import pkgutil
@@ -12,6 +12,10 @@ import sim.effects
 import sim.engine
 
 SOURCE = Path(sim.__file__).parent
+
+#: the most positional arguments a function of sim takes: more go in a named group
+#: (sim.engine.groups) or a tuple of what belongs together
+MOST_POSITIONAL = 12
 
 #: what the engine and the effects must not load: the config machinery and the layers above
 ABOVE = ("omegaconf", "hydra", "sim.pipeline", "sim.storage", "sim.analysis", "sim.checks",
@@ -63,3 +67,14 @@ def test_no_module_of_sim_imports_itself_back():
                     seen.add(imported)
                     stack.append((imported, (*path, imported)))
     assert len(graph) > 100 and not circles, circles
+
+
+def test_no_function_takes_more_than_twelve_positional_arguments():
+    long_lists = []
+    for path in SOURCE.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.FunctionDef):
+                count = len(node.args.posonlyargs) + len(node.args.args)
+                if count > MOST_POSITIONAL:
+                    long_lists.append(f"{path.relative_to(SOURCE)}: {node.name} takes {count}")
+    assert not long_lists, long_lists

@@ -59,6 +59,7 @@ from sim.effects.thermal_walls import is_thermal, seed_value
 from sim.effects.values import ConfigError, positive, select, within
 from sim.engine.inputs import real_number, refused, shaped_reals
 from sim.engine.kinematics import RADIUS, VX, VY
+from sim.engine.parameters import per_disk
 
 #: The tangential restitution of a smooth contact: no tangential impulse.
 SMOOTH = -1.0
@@ -406,39 +407,42 @@ def maxwellian_spins(rng, temperature, inertia):
     return rng.normal(0.0, 1.0, inertia.shape) * np.sqrt(temperature / inertia)
 
 
-def _smooth_disks(roughness, friction, spin, tc, i, j, rx, ry, virial, t, t_last, s_i, s_j,
-                  disks, m_i, m_j):
+def _smooth_disks(roughness, effects, i, j, rx, ry, virial, t, disks, m_i, m_j):
     return 0.0
 
 
 @effect_rule(_smooth_disks)
-def rough_collision(roughness, friction, spin, tc, i, j, rx, ry, virial, t, t_last, s_i, s_j,
-                    disks, m_i, m_j):
-    """The tangential part of the collision of disks i and j (species s_i, s_j) at time t,
-    at separation r = r_i − r_j, after the normal impulse whose virial r·Δp_i = P_n |r| the
-    smooth rule returned (zero: no contact, nothing to do), with the TC model's choice
-    (:func:`tc_roughness`). Returns the energy lost."""
+def rough_collision(roughness, effects, i, j, rx, ry, virial, t, disks, m_i, m_j):
+    """The tangential part of the collision of disks i and j (masses m_i, m_j; the loop's
+    groups ``effects`` and ``disks``, :mod:`sim.engine.groups`) at time t, at separation
+    r = r_i − r_j, after the normal impulse whose virial r·Δp_i = P_n |r| the smooth rule
+    returned (zero: no contact, nothing to do), with friction and the TC model's choice
+    (:func:`tc_roughness`) when the scene has them. Returns the energy lost."""
     if virial <= 0.0:
         return 0.0
-    beta = tc_roughness(tc, roughness.beta[s_i, s_j], t, t_last[i], t_last[j])
+    t_last = disks.t_last
+    s_i = per_disk(disks.species, i)
+    s_j = per_disk(disks.species, j)
+    beta = tc_roughness(effects.tc, roughness.beta[s_i, s_j], t, t_last[i], t_last[j])
     inverse_r = 1.0 / math.sqrt(rx * rx + ry * ry)
-    return rough_contact(i, j, rx * inverse_r, ry * inverse_r, virial * inverse_r, disks,
-                         spin, m_i, m_j, roughness.q, beta, friction_of(friction, s_i, s_j))
+    return rough_contact(i, j, rx * inverse_r, ry * inverse_r, virial * inverse_r, disks.table,
+                         effects.spin, m_i, m_j, roughness.q, beta,
+                         friction_of(effects.friction, s_i, s_j))
 
 
-def _smooth_wall(roughness, friction, spin, tc, temperature, i, wall, impulse, t, t_last,
-                 disks, m):
+def _smooth_wall(roughness, effects, i, wall, impulse, t, disks, m):
     return 0.0
 
 
 @effect_rule(_smooth_wall)
-def rough_wall_contact(roughness, friction, spin, tc, temperature, i, wall, impulse, t,
-                       t_last, disks, m):
+def rough_wall_contact(roughness, effects, i, wall, impulse, t, disks, m):
     """The tangential part of disk i's contact with ``wall`` at time t, after the wall gave
     it the momentum ``impulse`` along its axis (zero: no contact); a thermal wall
-    (``temperature``) redraws the velocity and keeps the spin. Returns the energy lost."""
-    if impulse == 0.0 or is_thermal(temperature, wall):
+    (``effects.wall_temperature``) redraws the velocity and keeps the spin. Returns the
+    energy lost."""
+    if impulse == 0.0 or is_thermal(effects.wall_temperature, wall):
         return 0.0
-    beta = tc_roughness(tc, roughness.beta_wall[wall], t, t_last[i], t_last[i])
-    return rough_wall(i, wall, abs(impulse), disks, spin, m, roughness.q, beta,
-                      wall_friction_of(friction, wall))
+    t_last = disks.t_last
+    beta = tc_roughness(effects.tc, roughness.beta_wall[wall], t, t_last[i], t_last[i])
+    return rough_wall(i, wall, abs(impulse), disks.table, effects.spin, m, roughness.q, beta,
+                      wall_friction_of(effects.friction, wall))

@@ -19,6 +19,7 @@ from sim.effects import Effects, keyword_doc, loop_values
 from sim.effects.walls import closing_time
 from sim.engine import codes
 from sim.engine.checkpoint import Checkpoints
+from sim.engine.groups import Box, Neighbours
 from sim.engine.inputs import (
     Boundary,
     box_size,
@@ -216,10 +217,8 @@ class Engine(Running, Observables, Checkpoints):
         self._common_capacity = common_value(d.nb_cap)
         shell_radius = self._per_disk_parameters()[0]
         while True:
-            full = build_all_neighbours(d.table, shell_radius, d.is_big, *self._list_layout(),
-                                        d.nb_count, d.nb, d.cell_head, d.cell_next,
-                                        d.cell_prev, d.cell_of, d.big, self.geometry, self.grid,
-                                        self.lookahead)
+            full = build_all_neighbours(d.table, shell_radius, d.is_big, self._neighbours(),
+                                        Box(self.geometry, self.grid), self.lookahead)
             if full < 0:
                 break
             self._grow_lists(full)
@@ -287,6 +286,13 @@ class Engine(Running, Observables, Checkpoints):
         if self._common_capacity is None:
             return self.disks.nb_start, self.disks.nb_cap
         return self._common_capacity, self._common_capacity
+
+    def _neighbours(self):
+        """The neighbour lists and cells as the compiled code takes them
+        (:class:`sim.engine.groups.Neighbours`, the lists' layout of :meth:`_list_layout`)."""
+        d = self.disks
+        return Neighbours(*self._list_layout(), d.nb_count, d.nb, d.cell_head, d.cell_next,
+                          d.cell_prev, d.cell_of, d.big)
 
     def _grow_lists(self, full):
         """Enlarge the lists after ``full`` overflowed. Lists of one common capacity all grow

@@ -187,10 +187,10 @@ def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
     m_j = per_disk(disks.mass, j)
     lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j)
     add_virial_tensor(effects.virial_tensor, rx, ry, virial)
+    lost += rough_collision(effects.roughness, effects, i, j, rx, ry, virial, t, disks, m_i,
+                            m_j)
     s_i = per_disk(disks.species, i)
     s_j = per_disk(disks.species, j)
-    lost += rough_collision(effects.roughness, effects.friction, effects.spin, effects.tc, i, j,
-                            rx, ry, virial, t, t_last, s_i, s_j, table, m_i, m_j)
     tallies.pair_collisions[min(s_i, s_j), max(s_i, s_j)] += 1
     disks.coll_count[i] += 1
     disks.coll_count[j] += 1
@@ -216,9 +216,7 @@ def touch_wall(i, wall, t, t_origin, disks, box, effects, tallies, wall_contacts
     lost, impulse, work = hit_wall(i, wall, t_origin + t, xi_w, disks.table, m, box.geometry,
                                    effects.wall_motion, effects.wall_temperature, key,
                                    effects.gravity, effects.tc)
-    lost += rough_wall_contact(effects.roughness, effects.friction, effects.spin, effects.tc,
-                               effects.wall_temperature, i, wall, impulse, t, t_last,
-                               disks.table, m)
+    lost += rough_wall_contact(effects.roughness, effects, i, wall, impulse, t, disks, m)
     tallies.wall_impulse[wall] += impulse
     disks.coll_count[i] += 1
     log_full = log_contact(effects.event_log, t_origin + t, i, -1 - wall, abs(impulse), lost,
@@ -378,11 +376,8 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
             dissipated_disks += lost
             virial_sum += virial
         elif partner == SHELL_EXIT:
-            nbs = neighbours
-            culprit = rebuild_neighbours(i, disks.table, disks.delta, nbs.nb_start, nbs.nb_cap,
-                                         nbs.nb_count, nbs.nb, nbs.cell_head, nbs.cell_next,
-                                         nbs.cell_prev, nbs.cell_of, nbs.big, box.geometry,
-                                         box.grid, limits.lookahead)
+            culprit = rebuild_neighbours(i, disks.table, disks.delta, neighbours, box,
+                                         limits.lookahead)
             if culprit >= 0:
                 status = STATUS_LIST_FULL
                 break

@@ -14,8 +14,9 @@ centre, so a disk changes cell only when it rebuilds. Cells are sized for the or
 are not filed in cells: every small disk checks them directly, and a big disk scans as many
 cells as its reach needs. So one projectile never forces large cells on everyone.
 
-Arrays (n disks):
-  disks float64[n, DISK_COLUMNS] — the disk table of :mod:`sim.engine.kinematics`, whose columns
+Arrays (n disks), of which the compiled functions take ``neighbours`` and ``box`` as the groups
+:class:`sim.engine.groups.Neighbours` and :class:`sim.engine.groups.Box`:
+  table float64[n, DISK_COLUMNS] — the disk table of :mod:`sim.engine.kinematics`, whose columns
   CX, CY hold the shell centre; delta float64[n], or one float when every shell has the same
   radius (:func:`sim.engine.parameters.per_disk`);
   nb_start int32[n], nb_cap int32[n], nb_count int32[n], nb int32[sum(nb_cap)] — list of disk i
@@ -79,19 +80,25 @@ def cell_index(x, y, geometry, grid):
 
 
 @njit(cache=True, inline="always")
-def _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
+def _cell_insert(i, c, neighbours):
+    """File disk i in cell c, at the head of its list."""
+    cell_head, cell_next, cell_prev = (neighbours.cell_head, neighbours.cell_next,
+                                       neighbours.cell_prev)
     head = cell_head[c]
     cell_next[i] = head
     cell_prev[i] = -1
     if head >= 0:
         cell_prev[head] = i
     cell_head[c] = i
-    cell_of[i] = c
+    neighbours.cell_of[i] = c
 
 
 @njit(cache=True, inline="always")
-def _cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
-    c = cell_of[i]
+def _cell_remove(i, neighbours):
+    """Take disk i out of the list of its cell."""
+    cell_head, cell_next, cell_prev = (neighbours.cell_head, neighbours.cell_next,
+                                       neighbours.cell_prev)
+    c = neighbours.cell_of[i]
     nxt = cell_next[i]
     prv = cell_prev[i]
     if prv >= 0:
@@ -117,17 +124,18 @@ def _remove_from_list(owner, disk, nb_start, nb_count, nb):
 
 
 @njit(cache=True, inline="always")
-def _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
+def _shells_overlap(cx, cy, i, j, table, delta, box):
     """Whether the shell of j overlaps a shell of disk i centred at (cx, cy) (NaN: never).
 
     The reach is summed per disk first, (R_i + δ_i) + (R_j + δ_j), and the separation only
     changes sign with the order, so the test gives the same answer for (i, j) and (j, i) to the
     last bit: the lists hold exactly the overlapping pairs, which the rebuild relies on.
     """
-    dx = minimum_image(cx - disks[j, CX], geometry[SIDE], grid[PERIODIC] != 0)
-    dy = minimum_image(cy - disks[j, CY], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
-    reach_i = disks[i, RADIUS] + per_disk(delta, i)
-    reach_j = disks[j, RADIUS] + per_disk(delta, j)
+    geometry, grid = box.geometry, box.grid
+    dx = minimum_image(cx - table[j, CX], geometry[SIDE], grid[PERIODIC] != 0)
+    dy = minimum_image(cy - table[j, CY], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
+    reach_i = table[i, RADIUS] + per_disk(delta, i)
+    reach_j = table[j, RADIUS] + per_disk(delta, j)
     reach = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
     return dx * dx + dy * dy < reach * reach
 
@@ -155,14 +163,14 @@ def _fold(a, nc):
 
 
 @njit(cache=True, inline="always")
-def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb, free,
-              room, geometry, grid):
-    """One candidate j for the search of :func:`_find_new_neighbours`: written into the next
-    free slot, counted when it is new. Returns the new count, or -1 when a new neighbour does
-    not fit the list."""
-    listed = _shells_overlap(cx_old, cy_old, i, j, disks, delta, geometry, grid)
+def _consider(j, found, search, table, delta, nb, free, room, box):
+    """One candidate j for the ``search`` of :func:`_find_new_neighbours`: written into the
+    next free slot, counted when it is new. Returns the new count, or -1 when a new neighbour
+    does not fit the list."""
+    i, cx, cy, cx_old, cy_old, first_candidate = search
+    listed = _shells_overlap(cx_old, cy_old, i, j, table, delta, box)
     new = ((j != i) & (j >= first_candidate) & (not listed)
-           & _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid))
+           & _shells_overlap(cx, cy, i, j, table, delta, box))
     if found < room:
         nb[free + found] = j
     elif new:
@@ -171,7 +179,7 @@ def _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks, delta
 
 
 @njit(cache=True, inline="always")
-def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid):
+def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, table, cell_head, cell_next, grid):
     """Hint the cache for the row of every disk filed in the cells of a scan (spans of
     :func:`axis_span`), before the scan reads them.
 
@@ -194,17 +202,16 @@ def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, gr
         for ax in range(x_lo, x_hi):
             j = cell_head[row + _fold(ax, ncx)]
             while j >= 0:
-                prefetch(disks, j)
+                prefetch(table, j)
                 j = cell_next[j]
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delta, nb_start,
-                         nb_cap, nb_count, nb, cell_head, cell_next, cell_of, big, geometry,
-                         grid, hint_candidates):
+def _find_new_neighbours(search, table, delta, neighbours, box, hint_candidates):
     """Append after the list of disk i (its count unchanged) every disk j ≥ first_candidate,
     j ≠ i, whose shell overlaps the shell of i centred at (cx, cy) but not the one centred at
-    (cx_old, cy_old); NaN for the old centre drops that condition.
+    (cx_old, cy_old); NaN for the old centre drops that condition. ``search`` is
+    ``(i, cx, cy, cx_old, cy_old, first_candidate)``.
 
     Small disks scan the 3×3 cells around (cx, cy) and the big disks; a big disk scans the cells
     within its reach. Returns the number of disks found, or -1 when they do not fit the list.
@@ -218,43 +225,46 @@ def _find_new_neighbours(i, cx, cy, cx_old, cy_old, first_candidate, disks, delt
     ``hint_candidates`` as a bool from Python, never a literal, so that they share one
     specialisation): 3.5 s less of the first compilation, and 2.8 s more for a literal.
     """
+    i, cx, cy, _, _, _ = search
+    geometry, grid = box.geometry, box.grid
+    nb_count, nb, cell_head, cell_next = (neighbours.nb_count, neighbours.nb,
+                                          neighbours.cell_head, neighbours.cell_next)
     ncx = grid[CELLS]
     ncy = grid[CELLS + 1]
     c = cell_index(cx, cy, geometry, grid)
-    if cell_of[i] >= 0:
+    if neighbours.cell_of[i] >= 0:
         kx = 1
         ky = 1
     else:
-        reach = disks[i, RADIUS] + per_disk(delta, i) + geometry[REACH]
+        reach = table[i, RADIUS] + per_disk(delta, i) + geometry[REACH]
         kx = int(math.ceil(reach / geometry[CELL_SIDE]))
         ky = int(math.ceil(reach / geometry[CELL_SIDE + 1]))
     x_lo, x_hi = axis_span(c % ncx, kx, ncx, grid[PERIODIC] != 0)
     y_lo, y_hi = axis_span(c // ncx, ky, ncy, grid[PERIODIC + 1] != 0)
-    free = list_start(nb_start, i) + nb_count[i]
-    room = per_disk(nb_cap, i) - nb_count[i]
+    free = list_start(neighbours.nb_start, i) + nb_count[i]
+    room = per_disk(neighbours.nb_cap, i) - nb_count[i]
     if hint_candidates:
-        _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, disks, cell_head, cell_next, grid)
+        _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, table, cell_head, cell_next, grid)
     found = 0
     for ay in range(y_lo, y_hi):
         row = _fold(ay, ncy) * ncx
         for ax in range(x_lo, x_hi):
             j = cell_head[row + _fold(ax, ncx)]
             while j >= 0:
-                found = _consider(j, found, i, cx, cy, cx_old, cy_old, first_candidate, disks,
-                                  delta, nb, free, room, geometry, grid)
+                found = _consider(j, found, search, table, delta, nb, free, room, box)
                 if found < 0:
                     return -1
                 j = cell_next[j]
+    big = neighbours.big
     for b in range(big.shape[0]):
-        found = _consider(big[b], found, i, cx, cy, cx_old, cy_old, first_candidate, disks,
-                          delta, nb, free, room, geometry, grid)
+        found = _consider(big[b], found, search, table, delta, nb, free, room, box)
         if found < 0:
             return -1
     return found
 
 
 @njit(cache=True, inline="always")
-def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
+def prefetch_cells(x, y, members, table, cell_head, cell_next, geometry, grid):
     """Hint the cache for a rebuild of a small disk's list near (x, y), which scans the 3×3
     cells around it (:func:`_find_new_neighbours`). Without ``members``: the heads of those
     cells. With ``members``: the heads are read (they should be in cache by now) and for each
@@ -274,14 +284,14 @@ def prefetch_cells(x, y, members, disks, cell_head, cell_next, geometry, grid):
         for ax in range(x_lo, x_hi):
             j = cell_head[row + _fold(ax, ncx)]
             if j >= 0:
-                prefetch(disks, j)
+                prefetch(table, j)
                 prefetch(cell_next, j)
                 if j > 0:
-                    prefetch(disks, j - 1)
+                    prefetch(table, j - 1)
 
 
 @njit(cache=True, inline="always")
-def shell_centre(i, disks, delta, geometry, grid):
+def shell_centre(i, table, delta, geometry, grid):
     """Centre (cx, cy) of a new shell for disk i: ahead of the disk along its velocity by
     λ δ_i, λ = ``geometry[LEAD]`` < 1, wrapped into a periodic box.
 
@@ -290,28 +300,27 @@ def shell_centre(i, disks, delta, geometry, grid):
     fly further than δ between collisions, rebuilds fewer lists. A disk at rest, or too slow
     ever to reach its shell (``TINY_SPEED_SQUARED``), is centred on itself.
     """
-    vx = disks[i, VX]
-    vy = disks[i, VY]
+    vx = table[i, VX]
+    vy = table[i, VY]
     speed_squared = vx * vx + vy * vy
     lead = (geometry[LEAD] * per_disk(delta, i) / math.sqrt(speed_squared)
             if speed_squared > TINY_SPEED_SQUARED else 0.0)
-    return (wrap(disks[i, X] + lead * vx, geometry[SIDE], grid[PERIODIC] != 0),
-            wrap(disks[i, Y] + lead * vy, geometry[SIDE + 1], grid[PERIODIC + 1] != 0))
+    return (wrap(table[i, X] + lead * vx, geometry[SIDE], grid[PERIODIC] != 0),
+            wrap(table[i, Y] + lead * vy, geometry[SIDE + 1], grid[PERIODIC + 1] != 0))
 
 
 @njit(cache=True, inline="always")
-def _full_list(first, found, nb_start, nb_cap, nb_count, nb):
+def _full_list(first, found, neighbours):
     """The first disk among ``nb[first : first + found]`` whose list is full, or -1."""
     for k in range(first, first + found):
-        j = nb[k]
-        if nb_count[j] >= per_disk(nb_cap, j):
+        j = neighbours.nb[k]
+        if neighbours.nb_count[j] >= per_disk(neighbours.nb_cap, j):
             return j
     return -1
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_head, cell_next,
-                       cell_prev, cell_of, big, geometry, grid, hint_candidates):
+def rebuild_neighbours(i, table, delta, neighbours, box, hint_candidates):
     """New shell for disk i centred on its current position, and its new list.
 
     Only the differences are written. The lists hold exactly the pairs of overlapping shells,
@@ -324,21 +333,22 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
     changed, and calling again after enlarging the lists does the rebuild.
     ``hint_candidates``: see :func:`_find_new_neighbours`.
     """
-    cx, cy = shell_centre(i, disks, delta, geometry, grid)
+    nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
+    cell_of = neighbours.cell_of
+    cx, cy = shell_centre(i, table, delta, box.geometry, box.grid)
     start = list_start(nb_start, i)
     old = nb_count[i]
-    found = _find_new_neighbours(np.int64(i), cx, cy, disks[i, CX], disks[i, CY], np.int64(0),
-                                 disks, delta, nb_start, nb_cap, nb_count, nb, cell_head,
-                                 cell_next, cell_of, big, geometry, grid, hint_candidates)
+    found = _find_new_neighbours((np.int64(i), cx, cy, table[i, CX], table[i, CY], np.int64(0)),
+                                 table, delta, neighbours, box, hint_candidates)
     if found < 0:
         return i
-    full = _full_list(start + old, found, nb_start, nb_cap, nb_count, nb)
+    full = _full_list(start + old, found, neighbours)
     if full >= 0:
         return full
     kept = start
     for k in range(start, start + old):
         j = nb[k]
-        if _shells_overlap(cx, cy, i, j, disks, delta, geometry, grid):
+        if _shells_overlap(cx, cy, i, j, table, delta, box):
             nb[kept] = j
             kept += 1
         else:
@@ -350,42 +360,41 @@ def rebuild_neighbours(i, disks, delta, nb_start, nb_cap, nb_count, nb, cell_hea
         nb[list_start(nb_start, j) + nb_count[j]] = i
         nb_count[j] += 1
     nb_count[i] = kept - start
-    disks[i, CX] = cx
-    disks[i, CY] = cy
+    table[i, CX] = cx
+    table[i, CY] = cy
     if cell_of[i] >= 0:
-        c = cell_index(cx, cy, geometry, grid)
+        c = cell_index(cx, cy, box.geometry, box.grid)
         if c != cell_of[i]:
-            _cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
-            _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+            _cell_remove(i, neighbours)
+            _cell_insert(i, c, neighbours)
     return -1
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def build_all_neighbours(disks, delta, is_big, nb_start, nb_cap, nb_count, nb, cell_head,
-                         cell_next, cell_prev, cell_of, big, geometry, grid, hint_candidates):
+def build_all_neighbours(table, delta, is_big, neighbours, box, hint_candidates):
     """Centre every shell on its disk, file the small disks in cells and link all pairs.
     Returns the disk whose list overflowed, or -1. ``hint_candidates``: see
     :func:`_find_new_neighbours`."""
-    n = disks.shape[0]
-    cell_head[:] = -1
+    nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
+    n = table.shape[0]
+    neighbours.cell_head[:] = -1
     nb_count[:] = 0
     for i in range(n):
-        disks[i, CX] = disks[i, X]
-        disks[i, CY] = disks[i, Y]
+        table[i, CX] = table[i, X]
+        table[i, CY] = table[i, Y]
         if is_big[i]:
-            cell_of[i] = -1
+            neighbours.cell_of[i] = -1
         else:
-            c = cell_index(disks[i, CX], disks[i, CY], geometry, grid)
-            _cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+            c = cell_index(table[i, CX], table[i, CY], box.geometry, box.grid)
+            _cell_insert(i, c, neighbours)
     for i in range(n):
         first = list_start(nb_start, i) + nb_count[i]
-        found = _find_new_neighbours(np.int64(i), disks[i, CX], disks[i, CY], np.nan, np.nan,
-                                     np.int64(i + 1), disks, delta, nb_start, nb_cap, nb_count,
-                                     nb, cell_head, cell_next, cell_of, big, geometry, grid,
-                                     hint_candidates)
+        found = _find_new_neighbours(
+            (np.int64(i), table[i, CX], table[i, CY], np.nan, np.nan, np.int64(i + 1)),
+            table, delta, neighbours, box, hint_candidates)
         if found < 0:
             return i
-        full = _full_list(first, found, nb_start, nb_cap, nb_count, nb)
+        full = _full_list(first, found, neighbours)
         if full >= 0:
             return full
         for k in range(first, first + found):

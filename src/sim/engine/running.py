@@ -12,7 +12,7 @@ from sim.effects.walls import piston_jam
 from sim.engine import codes, loop
 from sim.engine.compilation import compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
-from sim.engine.groups import Box, Disks, Limits, Neighbours, Schedule, Tallies
+from sim.engine.groups import Box, Disks, Limits, Schedule, Tallies
 from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 
@@ -46,8 +46,7 @@ class Running:
                 Disks(d.table, *self._per_disk_parameters(), d.coll_count, d.contacts,
                       d.t_last, d.streak),
                 Schedule(d.event_time, d.event_partner, d.event_count, *d.queue),
-                Neighbours(*self._list_layout(), d.nb_count, d.nb, d.cell_head, d.cell_next,
-                           d.cell_prev, d.cell_of, d.big),
+                self._neighbours(),
                 Box(self.geometry, self.grid),
                 self._effects(),
                 Tallies(self.counters, self.accumulators, self.pair_collisions,
