@@ -407,6 +407,13 @@ def test_the_engine_refuses_bad_effect_keywords_naming_them(case):
     assert words in message
 
 
+def test_the_engine_refuses_a_system_event_of_no_registered_kind():
+    message = refused("^Engine", [[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]], 0.01,
+                      system_event=(1.0, 2.0))
+    assert "Engine(system_event=…) is not allowed: None, or a value of a kind registered " \
+           "with sim.engine.system.handler (a tuple is none)" == message
+
+
 def test_the_effect_keywords_take_numpy_numbers_and_whole_floats():
     """What the table above refuses is all: numpy booleans and numbers, whole floats, tuples."""
     scene = {"n": 2, "n_species": 2, "box": np.ones(2), "periodic": np.zeros(2, dtype=bool),

@@ -1,8 +1,9 @@
 """One word, one meaning: a *contact* is a disk touching a disk (a *collision*) or a wall (a
 *wall contact*); an *event* is what the loop applies, a contact or a neighbour-shell exit
 (:mod:`sim.engine.codes`). The names these words replaced in 0.1.0 are gone; a run file of
-0.1.0, whose config still holds the old stop key (null), resumes to the same bits, and one of
-an older sim is refused in one line."""
+0.1.0, whose config still holds the old stop key (null) and whose checkpoints name the
+staleness stamps as collision counts, resumes to the same bits, and one of an older sim is
+refused in one line."""
 
 import h5py
 import numpy as np
@@ -11,6 +12,7 @@ import yaml
 
 from sim.analysis.datasets import open_run
 from sim.engine import Engine
+from sim.engine.checkpoint import RENAMED_ARRAYS
 from sim.pipeline import runner
 from sim.pipeline.config import ConfigError, register
 from sim.pipeline.initial import fixed_speed, radius_for_packing, random_sequential
@@ -63,11 +65,23 @@ def _stored_stop(path, **stop):
         parameters["config"] = yaml.safe_dump(config)
 
 
+def _checkpoints_of_0_1_0(path):
+    """Lay out the checkpoints of the run file at ``path`` as sim 0.1.0 did: the staleness
+    stamps under their old names, and no counted stamps or system-event slot."""
+    with h5py.File(path, "r+") as f:
+        for slot in f["checkpoint"].values():
+            for old, new in RENAMED_ARRAYS.items():
+                slot.move(new, old)
+            for name in ("disks/counted", "disks/system_time"):
+                del slot[name]
+
+
 def test_a_run_file_of_version_0_1_0_resumes_to_the_same_bits(tmp_path):
     overrides = ["scenario=single_disk", "output.progress=false"]
     whole = runner.run(compose_overrides([*overrides, "stop.contacts=300"]), tmp_path / "whole")
     path = runner.run(compose_overrides([*overrides, "stop.contacts=200"]), tmp_path / "part")
     _stored_stop(path, events=None)  # 0.1.0 stored the renamed key, null
+    _checkpoints_of_0_1_0(path)
     resume(path, ["stop.contacts=300"])
     with open_run(path) as resumed, open_run(whole) as ds:
         np.testing.assert_array_equal(resumed["position"].values[-1], ds["position"].values[-1])

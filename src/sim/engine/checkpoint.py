@@ -6,8 +6,26 @@ import math
 
 import numpy as np
 
-from sim.engine import loop
 from sim.engine.parameters import common_value
+from sim.engine.stamps import count_all_contacts
+
+#: the arrays of a checkpoint of sim 0.1.0 by their names now (the staleness stamps were its
+#: collision counts, :mod:`sim.engine.stamps`)
+RENAMED_ARRAYS = {"disks/coll_count": "disks/stamp", "disks/event_count": "disks/event_stamp"}
+
+
+def upgraded(state):
+    """A checkpoint of sim 0.1.0 as one of today: its arrays renamed (:data:`RENAMED_ARRAYS`),
+    and those it lacks with the values they had then: every stamp counted (it was saved
+    after a count), no system event. Today's checkpoints are returned as they are."""
+    state = dict(state)
+    for old, new in RENAMED_ARRAYS.items():
+        if old in state:
+            state.setdefault(new, state.pop(old))
+    if "disks/counted" not in state and "disks/stamp" in state:
+        state["disks/counted"] = np.array(state["disks/stamp"])
+    state.setdefault("disks/system_time", np.array([np.inf]))
+    return state
 
 
 class Checkpoints:
@@ -16,7 +34,7 @@ class Checkpoints:
     def state_dict(self):
         """Every array that evolves, by name: restoring it into an engine built from the same
         inputs continues the run to the same bits."""
-        loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
+        count_all_contacts(self.disks.stamp, self.disks.counted, self.disks.contacts)
         self.drain_event_log()
         state = {f"disks/{name}": value for name, value in vars(self.disks).items()
                  if value is not None}
@@ -31,7 +49,9 @@ class Checkpoints:
         """Replace the evolving arrays by those of :meth:`state_dict` (copied). A state of
         another scene — other arrays, or arrays of other shapes than this engine's (the
         neighbour lists ``disks/nb`` aside, which grow) — is refused with a ValueError before
-        anything is replaced."""
+        anything is replaced. A checkpoint of sim 0.1.0 is read as one of today
+        (:func:`upgraded`)."""
+        state = upgraded(state)
         mine = {key: np.shape(value) for key, value in self.state_dict().items()}
         missing, unknown = sorted(set(mine) - set(state)), sorted(set(state) - set(mine))
         if missing or unknown:

@@ -2,10 +2,14 @@
 
 Words: a *contact* is a disk touching a disk (a *collision*) or a wall (a *wall contact*); an
 *event* is what the loop applies: a contact or a shell exit. Stale events and first
-predictions are popped from the queue but are no events.
+predictions are popped from the queue but are no events; a *system event*
+(:mod:`sim.engine.system`) is applied to the whole system and is not counted among them.
 """
 
-# event partners other than a disk
+# The kinds of event, by their code in Schedule.event_partner: a code ≥ 0 is a pair event
+# with that disk; the others are the codes below, named in KINDS. Each disk owns one event;
+# a system event is no disk's (the schedule's slot) and SYSTEM names it where a code is
+# asked for (stop_status).
 NO_EVENT = -1
 SHELL_EXIT = -2
 WALL_X_LOW = -3  # wall codes: WALL_X_LOW - (2 * axis + side)
@@ -13,6 +17,20 @@ WALL_X_HIGH = -4
 WALL_Y_LOW = -5
 WALL_Y_HIGH = -6
 UNPREDICTED = -7  # a disk awaiting its first prediction, queued at the current time
+SYSTEM = -8
+
+#: code → what the event is
+KINDS = {NO_EVENT: "nothing", SHELL_EXIT: "shell exit", WALL_X_LOW: "wall contact (x low)",
+         WALL_X_HIGH: "wall contact (x high)", WALL_Y_LOW: "wall contact (y low)",
+         WALL_Y_HIGH: "wall contact (y high)", UNPREDICTED: "first prediction",
+         SYSTEM: "system event"}
+
+
+def kind(code):
+    """What an event of the code ``code`` is: a collision for a pair event (``code`` ≥ 0),
+    else as :data:`KINDS` says."""
+    return "collision" if code >= 0 else KINDS[code]
+
 
 # loop status
 STATUS_EVENT_LIMIT = 1

@@ -12,6 +12,12 @@ alike and leave an entry pointing at the other's code. So:
   after it in the cache folder; the others wait and then load it from the cache;
 * numba's cache saves an entry (index and code) under a lock of the function's index.
 
+numba keeps all variants of a function in one index, a pickle of their argument types: a
+variant whose types are defined outside sim (a user's kind of system event, in a module only
+their script imports) would make the index unreadable to every other process. Such variants
+are compiled by a dispatcher without a cache (:func:`cacheable`), at every start of their
+process; all of sim's own are cached, and a second start of a scene compiles nothing.
+
 Both locks are ``flock(2)`` locks, released by the system when their process ends.
 """
 
@@ -56,6 +62,13 @@ def compile_once(function, arguments):
     with _held(os.path.join(os.environ["NUMBA_CACHE_DIR"], name)):
         function.compile(signature)
     return time.perf_counter() - started
+
+
+def cacheable(*values):
+    """Whether numba may cache a compiled function called with ``values``: each is None or
+    of a type defined in sim."""
+    return all(value is None or type(value).__module__.partition(".")[0] == "sim"
+               for value in values)
 
 
 def _saved_under_lock(save):

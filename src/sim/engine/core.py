@@ -58,6 +58,7 @@ from sim.engine.sizing import (
     stall_interval,
 )
 from sim.engine.state import OPTIONAL_PER_DISK, DiskArrays
+from sim.engine.system import HANDLERS
 
 
 class Engine(Running, Observables, Checkpoints):
@@ -77,6 +78,9 @@ class Engine(Running, Observables, Checkpoints):
         fraction, :data:`LEAD_TABLE`); changes the cost, never the physics
     list_capacity : initial slots per neighbour list of an ordinary disk, whole from 1 to n
         (default from the expected number of neighbours); full lists grow on demand
+    system_event : a system event (:mod:`sim.engine.system`): a value of a kind whose
+        handler is registered, applied to the whole system first at t = 0 and then at the
+        times its handler returns; default None, none
 
     The effects' keywords (keyword-only; each effect's ``KEYWORDS``, :mod:`sim.effects`):
 
@@ -84,7 +88,7 @@ class Engine(Running, Observables, Checkpoints):
 
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
                  boundary=Boundary(), *, shell=None, list_capacity=None, shell_lead=None,
-                 **effects):
+                 system_event=None, **effects):
         position = real_array("Engine", "position", position)
         velocity = real_array("Engine", "velocity", velocity)
         n = position.shape[0] if position.ndim else 0
@@ -130,6 +134,11 @@ class Engine(Running, Observables, Checkpoints):
                              f"disks may touch but not overlap")
         self.closing_time = closing_time(self.wall_motion, box, periodic, float(radius.max()))
 
+        if system_event is not None and type(system_event) not in HANDLERS:
+            raise refused("Engine", "system_event", system_event,
+                          f"None, or a value of a kind registered with "
+                          f"sim.engine.system.handler (a {type(system_event).__name__} is none)")
+        self.system_event = system_event
         self.radius = radius
         self.mass = mass
         self.species = species
@@ -256,16 +265,19 @@ class Engine(Running, Observables, Checkpoints):
         table[:, RADIUS] = radius
         return DiskArrays(
             table=table, delta=delta, mass=self.mass.copy(), species=self.species.copy(),
-            is_big=is_big, coll_count=np.zeros(n, np.int32), contacts=np.zeros(n, np.int64),
+            is_big=is_big, stamp=np.zeros(n, np.int32), counted=np.zeros(n, np.int32),
+            contacts=np.zeros(n, np.int64),
             t_last=np.full(n, -np.inf),
             streak=np.zeros(n, np.int32), event_time=np.empty(n),
-            event_partner=np.empty(n, np.int32), event_count=np.zeros(n, np.int32),
+            event_partner=np.empty(n, np.int32), event_stamp=np.zeros(n, np.int32),
             links=links, nb_start=list_starts(cap), nb_cap=cap, nb_count=np.zeros(n, np.int32),
             cell_next=minus_one.copy(), cell_prev=minus_one.copy(), cell_of=minus_one.copy(),
             order=np.arange(n, dtype=np.int32), nb=np.full(int(cap.sum()), -1, dtype=np.int32),
             heap=heap, list_head=list_head, calendar=calendar, block_rate=block_rate,
             big=big.astype(np.int32),
-            cell_head=np.full(n_cells, -1, dtype=np.int32), **disk_effects)
+            cell_head=np.full(n_cells, -1, dtype=np.int32),
+            system_time=np.array([np.inf if self.system_event is None else 0.0]),
+            **disk_effects)
 
     def _effects(self):
         """The scene's effects as the compiled loop takes them (:class:`sim.effects.Effects`):

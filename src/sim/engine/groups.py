@@ -1,8 +1,9 @@
 """The arguments of the compiled loop, in named groups.
 
-:func:`sim.engine.loop.run_events` takes seven tuples: what it reads and writes of the disks,
+:func:`sim.engine.loop.run_events` takes eight tuples: what it reads and writes of the disks,
 the schedule of their events, the neighbour lists and cells, the box, the effects
-(:class:`sim.effects.Effects`), the running tallies and the limits of one call. numba
+(:class:`sim.effects.Effects`), the parts a scene may replace, the running tallies and the
+limits of one call. numba
 passes a tuple's fields as separate arguments, so grouping costs nothing; fields are read by
 name, and a field that is a number where it could be an array (a mass every disk shares, one
 list capacity for all) compiles a variant that never loads the array
@@ -20,22 +21,25 @@ class Disks(NamedTuple):
     delta: object  # float64[n] shell radii, or the one every disk shares
     mass: object  # float64[n], or the one every disk shares
     species: object  # int32[n], or the one every disk shares
-    coll_count: np.ndarray  # int32[n] contacts modulo 2³², the staleness counter
+    stamp: np.ndarray  # int32[n] staleness stamps (sim.engine.stamps)
+    counted: np.ndarray  # int32[n] the stamp at which contacts was last counted
     contacts: np.ndarray  # int64[n] contacts in full, updated at every rebase
     t_last: np.ndarray  # float64[n] time of the last contact (collapse watch, TC)
     streak: np.ndarray  # int32[n] consecutive fast dissipative contacts
 
 
 class Schedule(NamedTuple):
-    """Each disk's next event and the queue that orders them (:mod:`sim.engine.queue`)."""
+    """Each disk's next event and the queue that orders them (:mod:`sim.engine.queue`), and
+    the slot of the system event (:mod:`sim.engine.system`)."""
     event_time: np.ndarray  # float64[n], relative clock
-    event_partner: np.ndarray  # int32[n]: a disk, or a code of sim.engine.loop
-    event_count: np.ndarray  # int32[n]: the partner's coll_count at prediction
+    event_partner: np.ndarray  # int32[n]: a disk, or the code of a kind (sim.engine.codes)
+    event_stamp: np.ndarray  # int32[n]: the partner's stamp at prediction
     heap: np.ndarray
     links: np.ndarray
     list_head: np.ndarray
     calendar: np.ndarray
     block_rate: np.ndarray
+    system_time: np.ndarray  # float64[1] the next system event, relative clock
 
 
 class Neighbours(NamedTuple):
@@ -55,6 +59,14 @@ class Box(NamedTuple):
     """The box and its cells (:mod:`sim.engine.box`)."""
     geometry: np.ndarray  # float64[GEOMETRY_SIZE]
     grid: np.ndarray  # int64[GRID_SIZE]
+
+
+class Parts(NamedTuple):
+    """The parts of the dynamics a scene may replace, by kind, each None for none (or the
+    default): a value of a kind registered with its module, whose rules numba picks by the
+    value's type. A kind may be defined outside sim, so no cached function but the loop takes
+    this group (:func:`sim.engine.compilation.cacheable`)."""
+    system: object  # the system event (sim.engine.system)
 
 
 class Tallies(NamedTuple):

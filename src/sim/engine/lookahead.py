@@ -35,20 +35,20 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule,
     them (on a day a miss took 200 ns): 1.135 at N = 1e5 (1.03–1.20), 1.26 at φ = 0.1, 1.20
     at 1e6 (1.13–1.33).
     """
-    table, coll_count = disks.table, disks.coll_count
-    event_partner, event_count, heap, links = (schedule.event_partner, schedule.event_count,
+    table, stamp = disks.table, disks.stamp
+    event_partner, event_stamp, heap, links = (schedule.event_partner, schedule.event_stamp,
                                                schedule.heap, schedule.links)
     nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
     if partner >= 0:
         prefetch(table, partner)
-        prefetch(coll_count, partner)
+        prefetch(stamp, partner)
         prefetch(links, partner)
         start = list_start(nb_start, partner)
         prefetch(nb, start)
         if lookahead:
             for k in range(start, start + nb_count[partner]):
                 prefetch(table, nb[k])
-                prefetch(coll_count, nb[k])
+                prefetch(stamp, nb[k])
     size = schedule.calendar[HEAP_SIZE]
     for slot in range(1, min(4 if lookahead else 3, size)):
         c = heap[slot]
@@ -56,8 +56,8 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule,
         prefetch(event_partner, c)
         prefetch(nb, list_start(nb_start, c))
         if lookahead:
-            prefetch(event_count, c)
-            prefetch(coll_count, c)
+            prefetch(event_stamp, c)
+            prefetch(stamp, c)
             prefetch(links, c)
             prefetch(nb_count, c)
     if not lookahead:
@@ -68,7 +68,7 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule,
         start = list_start(nb_start, c)
         for k in range(start, start + nb_count[c]):
             prefetch(table, nb[k])
-            prefetch(coll_count, nb[k])
+            prefetch(stamp, nb[k])
             if partner_c == SHELL_EXIT:
                 prefetch(nb, list_start(nb_start, nb[k]))
                 prefetch(nb_count, nb[k])
@@ -76,8 +76,8 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule,
             prefetch(table, partner_c)
             prefetch(nb, list_start(nb_start, partner_c))
             prefetch(nb_count, partner_c)
-            prefetch(coll_count, partner_c)
-            prefetch(event_count, partner_c)
+            prefetch(stamp, partner_c)
+            prefetch(event_stamp, partner_c)
         elif partner_c == SHELL_EXIT:
             prefetch(neighbours.cell_of, c)
             prefetch(neighbours.cell_prev, c)

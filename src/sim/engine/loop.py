@@ -2,13 +2,18 @@
 
 Each disk owns one scheduled event, the earliest of (Smallenburg, Eur. Phys. J. E 45, 22 (2022)):
   * a contact with a disk of its neighbour list (``partner ≥ 0``), valid while the partner's
-    collision counter still equals the value recorded at prediction, and scheduled only when
-    it comes no later than the partner's own next event (:func:`predict`);
+    staleness stamp (:mod:`sim.engine.stamps`) still equals the value recorded at prediction,
+    and scheduled only when it comes no later than the partner's own next event
+    (:func:`predict`);
   * a contact with a wall (``partner = WALL_X_LOW … WALL_Y_HIGH``);
   * its exit from its neighbour shell (``partner = SHELL_EXIT``), which rebuilds its list;
   * at construction, its first prediction (``partner = UNPREDICTED``, at the current time):
     every disk is predicted through the loop's one inlined copy of :func:`predict`, which
     spares the compiler a second copy.
+The codes of these kinds are :data:`sim.engine.codes.KINDS`. A system event, something done to
+the whole system at a time, is no disk's: it waits in the schedule's slot, and the loop
+applies it before the disk event at the head of the queue when it comes no later
+(:mod:`sim.engine.system`; compiled away when the scene has none).
 Positions are advanced lazily: disk i is stored at ``table[i, X:Y+1]`` at its own time
 ``table[i, T_OWN]`` (disk table columns in :mod:`sim.engine.kinematics`). Every
 ``rebase_every`` events all disks are brought to the current time and the clock restarts from
@@ -61,6 +66,7 @@ from sim.engine.codes import (
     STATUS_NO_EVENTS,
     STATUS_STALLED,
     STATUS_TIME_REACHED,
+    SYSTEM,
     T_NOW,
     T_ORIGIN,
     UNPREDICTED,
@@ -95,13 +101,15 @@ from sim.engine.queue import (
     prefetch_bucket,
     reschedule,
 )
+from sim.engine.stamps import count_contacts
+from sim.engine.system import apply_system_event, system_due
 
 
 @njit(cache=True, inline="always")
 def predict(i, t, disks, schedule, neighbours, box, effects, t_origin):
     """The earliest event of disk i, which must be at time t already (``t_origin``: the
     absolute time of the clock's zero, which moving walls need): its time, its partner (a
-    disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's collision count when
+    disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's staleness stamp when
     the partner is a disk (else 0), for :func:`set_event`.
 
     A contact with j at time t_ij is left out when j's own next event comes first
@@ -158,17 +166,17 @@ def predict(i, t, disks, schedule, neighbours, box, effects, t_origin):
                 partner = j
     if tau == INF:
         partner = NO_EVENT
-    return t + tau, partner, disks.coll_count[partner] if partner >= 0 else np.int32(0)
+    return t + tau, partner, disks.stamp[partner] if partner >= 0 else np.int32(0)
 
 
 @njit(cache=True, inline="always")
-def set_event(i, when, partner, partner_count, schedule):
+def set_event(i, when, partner, partner_stamp, schedule):
     """Record the event :func:`predict` found for disk i; filing it in the queue
     (:func:`sim.engine.queue.reschedule`) comes after."""
     schedule.event_time[i] = when
     schedule.event_partner[i] = partner
     if partner >= 0:
-        schedule.event_count[i] = partner_count
+        schedule.event_stamp[i] = partner_stamp
 
 
 @njit(cache=True, inline="always")
@@ -192,8 +200,8 @@ def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
     s_i = per_disk(disks.species, i)
     s_j = per_disk(disks.species, j)
     tallies.pair_collisions[min(s_i, s_j), max(s_i, s_j)] += 1
-    disks.coll_count[i] += 1
-    disks.coll_count[j] += 1
+    disks.stamp[i] += 1
+    disks.stamp[j] += 1
     log_full = log_contact(effects.event_log, t_origin + t, i, j,
                            virial / math.sqrt(rx * rx + ry * ry), lost, contact)
     collapsing_i = collapsing(effects.collapse, t_last, disks.streak, i, xi, t)
@@ -218,32 +226,17 @@ def touch_wall(i, wall, t, t_origin, disks, box, effects, tallies, wall_contacts
                                    effects.gravity, effects.tc)
     lost += rough_wall_contact(effects.roughness, effects, i, wall, impulse, t, disks, m)
     tallies.wall_impulse[wall] += impulse
-    disks.coll_count[i] += 1
+    disks.stamp[i] += 1
     log_full = log_contact(effects.event_log, t_origin + t, i, -1 - wall, abs(impulse), lost,
                            contact)
     return lost, work, log_full, collapsing(effects.collapse, t_last, disks.streak, i, xi_w, t)
-
-
-@njit(cache=True, inline="always")
-def count_contacts(coll_count, contacts):
-    """Bring the full contact counts ``contacts`` int64[n] up to date with the counters
-    ``coll_count`` int32[n], which wrap at 2³²: correct while no disk makes 2³² contacts
-    between two calls, and it is called at every clock rebase."""
-    for i in range(coll_count.shape[0]):
-        contacts[i] += (np.int64(coll_count[i]) - contacts[i]) & 0xFFFFFFFF
-
-
-@njit(cache=True, _nrt=False, error_model="numpy")
-def count_all_contacts(coll_count, contacts):
-    """:func:`count_contacts`, called from Python."""
-    count_contacts(coll_count, contacts)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def rebase_clock(disks, schedule, box, effects, accumulators):
     """Bring every disk to the current time and restart the clock there (order-preserving);
     the event queue is rebuilt for the shifted times, and the contact counts are updated."""
-    count_contacts(disks.coll_count, disks.contacts)
+    count_contacts(disks.stamp, disks.counted, disks.contacts)
     t0 = accumulators[T_NOW]
     table = disks.table
     for i in range(table.shape[0]):
@@ -251,6 +244,7 @@ def rebase_clock(disks, schedule, box, effects, accumulators):
         table[i, T_OWN] = 0.0
         disks.t_last[i] -= t0
         schedule.event_time[i] -= t0
+    schedule.system_time[0] -= t0
     accumulators[T_ORIGIN] += t0
     accumulators[T_NOW] = 0.0
     build_queue(schedule.heap, schedule.links, schedule.list_head, schedule.calendar,
@@ -269,16 +263,16 @@ def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origi
     recorded only once i is filed."""
     s = schedule
     moved_disks = 1 if j < 0 else 2
-    when, whom, whose_count = INF, NO_EVENT, np.int32(0)
+    when, whom, whose_stamp = INF, NO_EVENT, np.int32(0)
     for k in range(moved_disks):
-        when, whom, whose_count = predict(i if k == 0 else j, t, disks, schedule, neighbours,
+        when, whom, whose_stamp = predict(i if k == 0 else j, t, disks, schedule, neighbours,
                                           box, effects, t_origin)
         prefetch_bucket(s.list_head, s.calendar, s.block_rate, when)
         if k == 0:
-            set_event(i, when, whom, whose_count, schedule)
+            set_event(i, when, whom, whose_stamp, schedule)
     for k in range(moved_disks):
         if k == 1:  # the prediction of j, the last one made
-            set_event(j, when, whom, whose_count, schedule)
+            set_event(j, when, whom, whose_stamp, schedule)
         reschedule(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time,
                    i if k == 0 else j)
 
@@ -317,7 +311,7 @@ def stop_status(limits, partner, t, t_stop, t_previous, stalled, stall_limit, ev
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
+def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits):
     """Process events in time order until :func:`stop_status` ends the loop; see the module
     docstring. Returns (status, the disk it concerns or −1).
 
@@ -352,11 +346,14 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
         i = earliest(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time)
         partner = s.event_partner[i]
         t = s.event_time[i]
+        if system_due(parts.system, s.system_time, t):
+            partner = SYSTEM
+            t = s.system_time[0]
         status, stalled = stop_status(limits, partner, t, t_stop, t_previous, stalled,
                                       stall_limit, events, collisions, wall_contacts,
                                       dissipated_disks + dissipated_walls, log_full)
         if status != 0:
-            culprit = i if status == STATUS_STALLED else -1
+            culprit = i if status == STATUS_STALLED and partner != SYSTEM else -1
             break
         t_previous = t
         walker, walker_block = prefetch_upcoming(partner, limits.lookahead, walker, walker_block,
@@ -364,7 +361,7 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
         t_origin = accumulators[T_ORIGIN]
         fly(i, t, disks.table, box.geometry, box.grid, effects.gravity, effects.images)
         j = NO_EVENT  # the second disk to re-predict, when it is a collision
-        if partner >= 0 and disks.coll_count[partner] != s.event_count[i]:
+        if partner >= 0 and disks.stamp[partner] != s.event_stamp[i]:
             stale_events += 1
         elif partner >= 0:
             j = partner
@@ -383,6 +380,11 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
                 break
             shell_exits += 1
             events += 1
+        elif partner == SYSTEM:  # i, at the head of the queue, was flown to t: no matter
+            s.system_time[0] = apply_system_event(parts.system, t, t_origin, disks, schedule,
+                                                  neighbours, box, effects)
+            t_now = t
+            continue
         elif partner != UNPREDICTED:
             wall_contacts += 1
             events += 1
@@ -420,6 +422,11 @@ def run_events(disks, schedule, neighbours, box, effects, tallies, limits):
     tallies.stall_watch[0] = t_previous
     tallies.stall_watch[1] = stalled
     return status, culprit
+
+
+#: :func:`run_events` without numba's cache, for arguments of types defined outside sim (a
+#: kind of system event written by a user, :func:`sim.engine.compilation.cacheable`)
+run_events_uncached = njit(_nrt=False, error_model="numpy")(run_events.py_func)
 
 
 @njit(cache=True)

@@ -11,6 +11,7 @@ from sim.effects.rotation import moment_of_inertia, rotational_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
+from sim.engine.stamps import count_all_contacts
 
 
 class Observables:
@@ -94,7 +95,7 @@ class Observables:
 
     def contacts_by_disk(self):
         """Contacts (disk and wall) of each disk so far: int64[n]."""
-        loop.count_all_contacts(self.disks.coll_count, self.disks.contacts)
+        count_all_contacts(self.disks.stamp, self.disks.counted, self.disks.contacts)
         return self._user_order(self.disks.contacts)
 
     def next_event_time(self):

@@ -10,9 +10,9 @@ import numpy as np
 from sim.effects.rotation import dissipates
 from sim.effects.walls import piston_jam
 from sim.engine import codes, loop
-from sim.engine.compilation import compile_once
+from sim.engine.compilation import cacheable, compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
-from sim.engine.groups import Box, Disks, Limits, Schedule, Tallies
+from sim.engine.groups import Box, Disks, Limits, Parts, Schedule, Tallies
 from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 
@@ -42,23 +42,26 @@ class Running:
             d = self.disks
             every = self.reorder_every
             reorder_at = (self.counters[codes.EVENTS] // every + 1) * every
+            parts = Parts(self.system_event)
             arguments = (
-                Disks(d.table, *self._per_disk_parameters(), d.coll_count, d.contacts,
+                Disks(d.table, *self._per_disk_parameters(), d.stamp, d.counted, d.contacts,
                       d.t_last, d.streak),
-                Schedule(d.event_time, d.event_partner, d.event_count, *d.queue),
+                Schedule(d.event_time, d.event_partner, d.event_stamp, *d.queue, d.system_time),
                 self._neighbours(),
                 Box(self.geometry, self.grid),
                 self._effects(),
+                parts,
                 Tallies(self.counters, self.accumulators, self.pair_collisions,
                         self.wall_impulse, self.stall_watch),
                 Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
                        dissipation_limit, self.stall_dt, self.rebase_every, self.lookahead))
             # the loop's variant is the engine's but for the lists' layout, which may change
             layout = self._common_capacity is None
+            run_events = loop.run_events if cacheable(*parts) else loop.run_events_uncached
             if self._compiled_layout is not layout:
-                self.compile_seconds += compile_once(loop.run_events, arguments)
+                self.compile_seconds += compile_once(run_events, arguments)
                 self._compiled_layout = layout
-            status, disk = loop.run_events(*arguments)
+            status, disk = run_events(*arguments)
             self.drain_event_log()
             if status == codes.STATUS_LOG_FULL:
                 continue
@@ -71,12 +74,14 @@ class Running:
                 continue
             if status == codes.STATUS_STALLED:
                 self._check_piston()  # a jammed piston stalls the clock too: say so
+                last = (f"a {codes.kind(codes.SYSTEM)}" if disk < 0 else
+                        f"disk {d.order[disk]}'s {codes.kind(int(d.event_partner[disk]))} at "
+                        f"position {d.table[disk, X:Y + 1].tolist()} with velocity "
+                        f"{d.table[disk, VX:VY + 1].tolist()}")
                 raise StalledError(
                     f"the clock has stalled at t = {self.time:.17g}: more than 16 N + 1000 "
                     f"events in a row, each within {self.stall_dt:.3g} (float64 resolution) of "
-                    f"the one before, last for disk {d.order[disk]} at position "
-                    f"{d.table[disk, X:Y + 1].tolist()} with velocity "
-                    f"{d.table[disk, VX:VY + 1].tolist()}; the state is beyond float64 "
+                    f"the one before, the last of them {last}; the state is beyond float64 "
                     f"resolution: for inelastic disks, and for disks resting on a wall under "
                     f"gravity, switch on the TC model (tc.time); a chain of disks touching all "
                     f"round a periodic box needs room between its disks")

@@ -8,11 +8,11 @@ Per-disk arrays (n disks, engine order):
   table float64[n, DISK_COLUMNS] — one 64-byte row per disk: position and velocity, the
       disk's own time, radius, shell centre (columns in :mod:`sim.engine.kinematics`);
   delta float64[n] — neighbour-shell radius; mass float64[n]; species int32[n]; is_big bool[n];
-  coll_count int32[n] — contacts (disk and wall) of each disk modulo 2³², the staleness
-      counter; contacts int64[n] — the same count in full, brought up to date from coll_count
-      at every clock rebase and whenever it is read (:func:`sim.engine.loop.count_contacts`);
+  stamp int32[n] — staleness stamps, counted int32[n] — the stamp when contacts int64[n],
+      each disk's contacts (disk and wall), was last brought up to date, at every clock
+      rebase and whenever it is read (:mod:`sim.engine.stamps`);
   t_last float64[n], streak int32[n] — time of the last contact, collapse streak;
-  event_time float64[n], event_partner int32[n], event_count int32[n] — scheduled event;
+  event_time float64[n], event_partner int32[n], event_stamp int32[n] — scheduled event;
   links int32[n, 3] — place in the event queue (:mod:`sim.engine.queue`);
   nb_start int32[n], nb_cap int32[n], nb_count int32[n] — neighbour-list layout;
   cell_next, cell_prev, cell_of int32[n] — cell lists; order int32[n] — original index;
@@ -20,7 +20,8 @@ Per-disk arrays (n disks, engine order):
   spin float64[n] — angular velocities (:mod:`sim.effects.rotation`), or None when no disk
   turns.
 Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
-calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells].
+calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells],
+system_time float64[1] (:mod:`sim.engine.system`).
 
 All of them live in one buffer (:func:`one_buffer`), each starting on a cache line, the
 buffer on a 2 MiB huge page.
@@ -34,8 +35,9 @@ import numpy as np
 from sim.engine.neighbours import copy_lists, list_starts
 from sim.engine.queue import NEXT, PREV
 
-PER_DISK = ("table", "delta", "mass", "species", "is_big", "coll_count", "contacts", "t_last",
-            "streak", "event_time", "event_partner", "event_count", "links", "nb_start", "nb_cap",
+PER_DISK = ("table", "delta", "mass", "species", "is_big", "stamp", "counted", "contacts",
+            "t_last",
+            "streak", "event_time", "event_partner", "event_stamp", "links", "nb_start", "nb_cap",
             "nb_count", "cell_next", "cell_prev", "cell_of", "order")
 
 CACHE_LINE = 64
@@ -72,13 +74,14 @@ class DiskArrays:
     mass: np.ndarray
     species: np.ndarray
     is_big: np.ndarray
-    coll_count: np.ndarray
+    stamp: np.ndarray
+    counted: np.ndarray
     contacts: np.ndarray
     t_last: np.ndarray
     streak: np.ndarray
     event_time: np.ndarray
     event_partner: np.ndarray
-    event_count: np.ndarray
+    event_stamp: np.ndarray
     links: np.ndarray
     nb_start: np.ndarray
     nb_cap: np.ndarray
@@ -94,6 +97,7 @@ class DiskArrays:
     block_rate: np.ndarray
     big: np.ndarray
     cell_head: np.ndarray
+    system_time: np.ndarray
     images: Optional[np.ndarray] = None
     spin: Optional[np.ndarray] = None
 
@@ -138,7 +142,8 @@ class DiskArrays:
         for name in PER_DISK + tuple(name for name in OPTIONAL_PER_DISK
                                      if getattr(self, name) is not None):
             np.take(old[name], perm, axis=0, out=new[name])
-        for name in ("heap", "list_head", "calendar", "block_rate", "big", "cell_head"):
+        for name in ("heap", "list_head", "calendar", "block_rate", "big", "cell_head",
+                     "system_time"):
             new[name][...] = old[name]
         for ids in (new["event_partner"], new["cell_next"], new["cell_prev"], new["cell_head"],
                     new["list_head"], new["links"][:, NEXT], new["links"][:, PREV], new["heap"],

@@ -346,6 +346,11 @@ class RunWriter:
                                                fletcher32=True)
                 if scalar:
                     dataset.attrs["scalar"] = True
+        stale = []  # arrays of a state of another version of sim
+        group.visititems(lambda name, item: stale.append(name)
+                         if isinstance(item, h5py.Dataset) and name not in state else None)
+        for name in stale:
+            del group[name]
         group.attrs["time"] = t
         group.attrs["snapshots"] = self.file["particles/disks/position/step"].shape[0]
         self._flush_file()
