@@ -10,6 +10,7 @@ from conftest import assert_no_overlap, gas
 from sim.checks.audit import overlapping_pairs
 from sim.engine import Boundary, Engine, InelasticCollapseError
 from sim.engine.codes import SHELL_EXITS, STALE_EVENTS
+from sim.engine.groups import Box
 from sim.engine.kinematics import DISK_COLUMNS, VX, VY, X, Y
 from sim.engine.neighbours import shell_centre
 from sim.engine.sizing import LIST_GROWTH, packing_fraction_around_disks, shell_ratio
@@ -245,11 +246,11 @@ def test_shell_centre_leads_its_disk_by_a_fraction_of_the_shell():
     geometry = np.array([1.0, 1.0, 0.1, 0.1, 0.05, 0.8])
     grid = np.array([10, 10, 1, 0])
     delta = 0.01
-    assert shell_centre(0, disks, delta, geometry, grid) == pytest.approx(
+    assert shell_centre(0, disks, delta, Box(geometry, grid)) == pytest.approx(
         (0.5 + 0.008 * 0.6, 0.5 - 0.008 * 0.8), abs=1e-15)
-    assert shell_centre(1, disks, delta, geometry, grid) == (0.5, 0.5)
-    assert shell_centre(2, disks, delta, geometry, grid) == (0.5, 0.5)
-    assert shell_centre(3, disks, delta, geometry, grid) == pytest.approx((0.006, 0.5),
+    assert shell_centre(1, disks, delta, Box(geometry, grid)) == (0.5, 0.5)
+    assert shell_centre(2, disks, delta, Box(geometry, grid)) == (0.5, 0.5)
+    assert shell_centre(3, disks, delta, Box(geometry, grid)) == pytest.approx((0.006, 0.5),
                                                                           abs=1e-15)
 
 

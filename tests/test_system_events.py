@@ -45,7 +45,7 @@ def toy(value, t, t_origin, disks, schedule, neighbours, box, effects):
         value.applied[0] += 1
         return np.inf
     if t > 0.0:
-        fly(0, t, table, box.geometry, box.grid, effects.gravity, effects.images)
+        fly(0, t, table, box, effects.gravity, effects.images)
         table[0, VX], table[0, VY] = -table[0, VY], table[0, VX]
         invalidate(0, disks)
         repredict(0, t, schedule)

@@ -7,6 +7,8 @@ neighbour lists, so it can catch their bugs.
 import numpy as np
 from scipy.spatial import cKDTree
 
+from sim.engine.box import folded, nearest_images
+
 
 def kd_tree(position, box, periodic):
     """A k-d tree of ``position`` float64[n, 2] that measures distances with the minimum image
@@ -16,7 +18,7 @@ def kd_tree(position, box, periodic):
     if not any(periodic):
         return cKDTree(position)
     boxsize = np.where(periodic, box, 1e30 * max(box.max(), 1.0))
-    return cKDTree(np.where(periodic, position % box, position), boxsize=boxsize)
+    return cKDTree(folded(position, box, periodic), boxsize=boxsize)
 
 
 def overlapping_pairs(position, radius, box=(1.0, 1.0), periodic=(False, False),
@@ -33,8 +35,7 @@ def overlapping_pairs(position, radius, box=(1.0, 1.0), periodic=(False, False),
     pairs = tree.query_pairs(2.0 * float(radius.max()), output_type="ndarray")
     if pairs.size == 0:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
-    r = position[pairs[:, 0]] - position[pairs[:, 1]]
-    r -= np.where(periodic, box * np.round(r / box), 0.0)
+    r = nearest_images(position[pairs[:, 0]] - position[pairs[:, 1]], box, periodic)
     distance = np.hypot(r[:, 0], r[:, 1])
     sigma = radius[pairs[:, 0]] + radius[pairs[:, 1]]
     bad = distance < sigma * (1.0 - tolerance)

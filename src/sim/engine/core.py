@@ -18,6 +18,7 @@ import numpy as np
 from sim.effects import Effects, keyword_doc, loop_values
 from sim.effects.walls import closing_time
 from sim.engine import codes
+from sim.engine.box import folded
 from sim.engine.checkpoint import Checkpoints
 from sim.engine.groups import Box, Neighbours
 from sim.engine.inputs import (
@@ -38,6 +39,7 @@ from sim.engine.kinematics import DISK_COLUMNS, RADIUS, VX, VY, X, Y
 from sim.engine.neighbours import build_all_neighbours, grow_lists, list_starts
 from sim.engine.observables import Observables
 from sim.engine.overlap import first_overlap
+from sim.engine.pairs import RULES
 from sim.engine.parameters import common_value
 from sim.engine.queue import BLOCK_EVENTS, build_queue, empty_queue
 from sim.engine.running import Running
@@ -78,6 +80,8 @@ class Engine(Running, Observables, Checkpoints):
         fraction, :data:`LEAD_TABLE`); changes the cost, never the physics
     list_capacity : initial slots per neighbour list of an ordinary disk, whole from 1 to n
         (default from the expected number of neighbours); full lists grow on demand
+    pair_interaction : a pair interaction (:mod:`sim.engine.pairs`): a value of a kind whose
+        rules are registered; default None, hard disks
     system_event : a system event (:mod:`sim.engine.system`): a value of a kind whose
         handler is registered, applied to the whole system first at t = 0 and then at the
         times its handler returns; default None, none
@@ -88,7 +92,7 @@ class Engine(Running, Observables, Checkpoints):
 
     def __init__(self, position, velocity, radius, mass=1.0, species=None,
                  boundary=Boundary(), *, shell=None, list_capacity=None, shell_lead=None,
-                 system_event=None, **effects):
+                 pair_interaction=None, system_event=None, **effects):
         position = real_array("Engine", "position", position)
         velocity = real_array("Engine", "velocity", velocity)
         n = position.shape[0] if position.ndim else 0
@@ -109,7 +113,7 @@ class Engine(Running, Observables, Checkpoints):
         self.box = box
         self.periodic = periodic
         given = position
-        position = np.where(periodic, position % box, position)
+        position = folded(position, box, periodic)
         check_inside(given, position, radius, box, periodic)
 
         with np.errstate(over="ignore"):  # inf for speeds that check_scales refuses below
@@ -134,10 +138,13 @@ class Engine(Running, Observables, Checkpoints):
                              f"disks may touch but not overlap")
         self.closing_time = closing_time(self.wall_motion, box, periodic, float(radius.max()))
 
-        if system_event is not None and type(system_event) not in HANDLERS:
-            raise refused("Engine", "system_event", system_event,
-                          f"None, or a value of a kind registered with "
-                          f"sim.engine.system.handler (a {type(system_event).__name__} is none)")
+        for name, value, registry, register in (
+                ("pair_interaction", pair_interaction, RULES, "sim.engine.pairs.rules"),
+                ("system_event", system_event, HANDLERS, "sim.engine.system.handler")):
+            if value is not None and type(value) not in registry:
+                raise refused("Engine", name, value, f"None, or a value of a kind registered "
+                              f"with {register} (a {type(value).__name__} is none)")
+        self.pair_interaction = pair_interaction
         self.system_event = system_event
         self.radius = radius
         self.mass = mass

@@ -14,8 +14,8 @@ from numba import njit
 
 from sim.effects.gravity import displacement, fall, velocity_at
 from sim.effects.unwrap import count_winding
-from sim.engine.box import PERIODIC, SIDE
-from sim.engine.kinematics import T_OWN, VX, X, wrap
+from sim.engine.box import fold
+from sim.engine.kinematics import T_OWN, VX, X
 
 
 @njit(cache=True, inline="always")
@@ -37,13 +37,14 @@ def velocity_of(i, axis, dt, disks, gravity):
 
 
 @njit(cache=True, inline="always")
-def fly(i, t, disks, geometry, grid, gravity, images):
+def fly(i, t, disks, box, gravity, images):
     """Move disk i to time t along its path and store it there (position folded into the
-    box on periodic axes, windings counted in ``images`` when given)."""
+    box on periodic axes, :func:`sim.engine.box.fold`; windings counted in ``images`` when
+    given)."""
     dt = t - disks[i, T_OWN]
     for axis in range(2):
         x = position_at(i, axis, dt, disks, gravity)
-        folded = wrap(x, geometry[SIDE + axis], grid[PERIODIC + axis] != 0)
+        folded = fold(box, x, axis)
         count_winding(images, i, axis, x, folded)
         disks[i, X + axis] = folded
         fall(gravity, disks, i, axis, dt)

@@ -66,6 +66,7 @@ class Parts(NamedTuple):
     default): a value of a kind registered with its module, whose rules numba picks by the
     value's type. A kind may be defined outside sim, so no cached function but the loop takes
     this group (:func:`sim.engine.compilation.cacheable`)."""
+    pair: object  # the pair interaction (sim.engine.pairs); None: hard disks
     system: object  # the system event (sim.engine.system)
 
 

@@ -81,7 +81,7 @@ def prefetch_upcoming(partner, lookahead, walker, walker_block, disks, schedule,
         elif partner_c == SHELL_EXIT:
             prefetch(neighbours.cell_of, c)
             prefetch(neighbours.cell_prev, c)
-            cx, cy = shell_centre(c, table, disks.delta, box.geometry, box.grid)
+            cx, cy = shell_centre(c, table, disks.delta, box)
             prefetch_cells(cx, cy, slot == 1, table, neighbours.cell_head, neighbours.cell_next,
                            box.geometry, box.grid)
     walker, walker_block = prefetch_next_block(walker, walker_block, links, schedule.list_head,

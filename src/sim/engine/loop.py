@@ -33,20 +33,18 @@ the code of every effect that is off. It returns ``(status, disk)``; errors are 
 as exceptions by the caller.
 """
 
-import math
 
 import numpy as np
 from numba import njit
 
 from sim.effects.event_log import log_contact
 from sim.effects.gravity import shell_exit
-from sim.effects.pressure_tensor import add_virial_tensor
-from sim.effects.restitution import collapsing, disk_restitution, wall_restitution_of
-from sim.effects.rotation import rough_collision, rough_wall_contact
+from sim.effects.restitution import collapsing, wall_restitution_of
+from sim.effects.rotation import rough_wall_contact
 from sim.effects.tc import tc_restitution
 from sim.effects.thermal_walls import contact_key
 from sim.effects.walls import hit_wall, predict_wall_contact
-from sim.engine.box import PERIODIC, SIDE
+from sim.engine.box import PERIODIC, fold, separation
 from sim.engine.codes import (
     COLLISIONS,
     DISSIPATED_DISKS,
@@ -75,7 +73,6 @@ from sim.engine.codes import (
     WALL_WORK,
     WALL_X_LOW,
 )
-from sim.engine.contact import collide_disks
 from sim.engine.flight import flown, fly, position_at, velocity_of
 from sim.engine.kinematics import (
     CX,
@@ -87,13 +84,10 @@ from sim.engine.kinematics import (
     VY,
     X,
     Y,
-    may_touch_before,
-    minimum_image,
-    pair_contact_time,
-    wrap,
 )
 from sim.engine.lookahead import prefetch_upcoming
 from sim.engine.neighbours import list_start, rebuild_neighbours
+from sim.engine.pairs import apply_pair_event, pair_event_time
 from sim.engine.parameters import per_disk
 from sim.engine.queue import (
     build_queue,
@@ -106,7 +100,7 @@ from sim.engine.system import apply_system_event, system_due
 
 
 @njit(cache=True, inline="always")
-def predict(i, t, disks, schedule, neighbours, box, effects, t_origin):
+def predict(i, t, disks, schedule, neighbours, box, effects, parts, t_origin):
     """The earliest event of disk i, which must be at time t already (``t_origin``: the
     absolute time of the clock's zero, which moving walls need): its time, its partner (a
     disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's staleness stamp when
@@ -125,16 +119,13 @@ def predict(i, t, disks, schedule, neighbours, box, effects, t_origin):
     table = disks.table
     geometry, grid = box
     gravity = effects.gravity
-    px = grid[PERIODIC] != 0
-    py = grid[PERIODIC + 1] != 0
     x = table[i, X]
     y = table[i, Y]
     vx = table[i, VX]
     vy = table[i, VY]
     r_i = table[i, RADIUS]
-    tau = shell_exit(gravity, minimum_image(x - table[i, CX], geometry[SIDE], px),
-                     minimum_image(y - table[i, CY], geometry[SIDE + 1], py), vx, vy,
-                     per_disk(disks.delta, i))
+    dx, dy = separation(box, x - table[i, CX], y - table[i, CY])
+    tau = shell_exit(gravity, dx, dy, vx, vy, per_disk(disks.delta, i))
     partner = SHELL_EXIT
     for axis in range(2):
         if grid[PERIODIC + axis] == 0:
@@ -153,17 +144,15 @@ def predict(i, t, disks, schedule, neighbours, box, effects, t_origin):
         dt = t - table[j, T_OWN]
         vx_j = velocity_of(j, 0, dt, table, gravity)
         vy_j = velocity_of(j, 1, dt, table, gravity)
-        rx = minimum_image(x - table[j, X] - flown(j, 0, dt, table, gravity), geometry[SIDE], px)
-        ry = minimum_image(y - table[j, Y] - flown(j, 1, dt, table, gravity), geometry[SIDE + 1],
-                           py)
+        rx, ry = separation(box, x - table[j, X] - flown(j, 0, dt, table, gravity),
+                            y - table[j, Y] - flown(j, 1, dt, table, gravity))
         vx_ij = vx - vx_j
         vy_ij = vy - vy_j
-        sigma = r_i + table[j, RADIUS]
-        if may_touch_before(rx, ry, vx_ij, vy_ij, sigma, tau):
-            tau_ij = pair_contact_time(rx, ry, vx_ij, vy_ij, sigma)
-            if tau_ij < tau and t + tau_ij <= event_time[j]:
-                tau = tau_ij
-                partner = j
+        tau_ij = pair_event_time(parts.pair, i, j, rx, ry, vx_ij, vy_ij, r_i + table[j, RADIUS],
+                                 tau, disks)
+        if tau_ij < tau and t + tau_ij <= event_time[j]:
+            tau = tau_ij
+            partner = j
     if tau == INF:
         partner = NO_EVENT
     return t + tau, partner, disks.stamp[partner] if partner >= 0 else np.int32(0)
@@ -177,37 +166,6 @@ def set_event(i, when, partner, partner_stamp, schedule):
     schedule.event_partner[i] = partner
     if partner >= 0:
         schedule.event_stamp[i] = partner_stamp
-
-
-@njit(cache=True, inline="always")
-def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
-    """The collision of disks i and j, both already flown to time t, as the ``contact``-th
-    contact of the run: restitution (with the TC model), the impulse
-    (:func:`sim.engine.contact.collide_disks`), what the recorders keep, the collapse watch.
-    Returns (energy dissipated, r·Δp_i, log full, the disk found collapsing or −1)."""
-    table, t_last = disks.table, disks.t_last
-    geometry, grid = box
-    rx = minimum_image(table[i, X] - table[j, X], geometry[SIDE], grid[PERIODIC] != 0)
-    ry = minimum_image(table[i, Y] - table[j, Y], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
-    xi = tc_restitution(effects.tc, disk_restitution(effects.restitution, disks.species, i, j),
-                        t, t_last[i], t_last[j])
-    m_i = per_disk(disks.mass, i)
-    m_j = per_disk(disks.mass, j)
-    lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j)
-    add_virial_tensor(effects.virial_tensor, rx, ry, virial)
-    lost += rough_collision(effects.roughness, effects, i, j, rx, ry, virial, t, disks, m_i,
-                            m_j)
-    s_i = per_disk(disks.species, i)
-    s_j = per_disk(disks.species, j)
-    tallies.pair_collisions[min(s_i, s_j), max(s_i, s_j)] += 1
-    disks.stamp[i] += 1
-    disks.stamp[j] += 1
-    log_full = log_contact(effects.event_log, t_origin + t, i, j,
-                           virial / math.sqrt(rx * rx + ry * ry), lost, contact)
-    collapsing_i = collapsing(effects.collapse, t_last, disks.streak, i, xi, t)
-    collapsing_j = collapsing(effects.collapse, t_last, disks.streak, j, xi, t)
-    culprit = i if collapsing_i else (j if collapsing_j else -1)
-    return lost, virial, log_full, culprit
 
 
 @njit(cache=True, inline="always")
@@ -240,7 +198,7 @@ def rebase_clock(disks, schedule, box, effects, accumulators):
     t0 = accumulators[T_NOW]
     table = disks.table
     for i in range(table.shape[0]):
-        fly(i, t0, table, box.geometry, box.grid, effects.gravity, effects.images)
+        fly(i, t0, table, box, effects.gravity, effects.images)
         table[i, T_OWN] = 0.0
         disks.t_last[i] -= t0
         schedule.event_time[i] -= t0
@@ -252,7 +210,7 @@ def rebase_clock(disks, schedule, box, effects, accumulators):
 
 
 @njit(cache=True, inline="always")
-def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origin):
+def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, parts, t_origin):
     """Predict the next event of disk i and, when j ≥ 0, of disk j, and file both.
 
     One call site each for predict and reschedule: numba inlines them wherever they are
@@ -266,7 +224,7 @@ def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origi
     when, whom, whose_stamp = INF, NO_EVENT, np.int32(0)
     for k in range(moved_disks):
         when, whom, whose_stamp = predict(i if k == 0 else j, t, disks, schedule, neighbours,
-                                          box, effects, t_origin)
+                                          box, effects, parts, t_origin)
         prefetch_bucket(s.list_head, s.calendar, s.block_rate, when)
         if k == 0:
             set_event(i, when, whom, whose_stamp, schedule)
@@ -359,17 +317,18 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
         walker, walker_block = prefetch_upcoming(partner, limits.lookahead, walker, walker_block,
                                                  disks, schedule, neighbours, box)
         t_origin = accumulators[T_ORIGIN]
-        fly(i, t, disks.table, box.geometry, box.grid, effects.gravity, effects.images)
+        fly(i, t, disks.table, box, effects.gravity, effects.images)
         j = NO_EVENT  # the second disk to re-predict, when it is a collision
         if partner >= 0 and disks.stamp[partner] != s.event_stamp[i]:
             stale_events += 1
         elif partner >= 0:
             j = partner
-            fly(j, t, disks.table, box.geometry, box.grid, effects.gravity, effects.images)
+            fly(j, t, disks.table, box, effects.gravity, effects.images)
             collisions += 1
             events += 1
-            lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
-                                                      tallies, collisions + wall_contacts)
+            lost, virial, log_full, culprit = apply_pair_event(
+                parts.pair, i, j, t, t_origin, disks, box, effects, tallies,
+                collisions + wall_contacts)
             dissipated_disks += lost
             virial_sum += virial
         elif partner == SHELL_EXIT:
@@ -397,7 +356,7 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
         if culprit >= 0:
             status = STATUS_COLLAPSE
             break
-        predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, t_origin)
+        predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, parts, t_origin)
         if (partner >= 0 and j < 0) or partner == UNPREDICTED:
             continue  # a stale event or a first prediction is no event: the clock stays
         t_now = t
@@ -430,7 +389,7 @@ run_events_uncached = njit(_nrt=False, error_model="numpy")(run_events.py_func)
 
 
 @njit(cache=True)
-def state_at(t, table, geometry, grid, gravity):
+def state_at(t, table, box, gravity):
     """Positions and velocities of all disks at time t (relative clock), without changing
     the state.
 
@@ -442,7 +401,6 @@ def state_at(t, table, geometry, grid, gravity):
     for i in range(n):
         dt = t - table[i, T_OWN]
         for axis in range(2):
-            position[i, axis] = wrap(position_at(i, axis, dt, table, gravity),
-                                     geometry[SIDE + axis], grid[PERIODIC + axis] != 0)
+            position[i, axis] = fold(box, position_at(i, axis, dt, table, gravity), axis)
             velocity[i, axis] = velocity_of(i, axis, dt, table, gravity)
     return position, velocity

@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from sim.engine.box import CELL_SIDE, CELLS, LEAD, PERIODIC, REACH, SIDE
+from sim.engine.box import CELL_SIDE, CELLS, LEAD, PERIODIC, REACH, fold, separation
 from sim.engine.kinematics import (
     CX,
     CY,
@@ -45,8 +45,6 @@ from sim.engine.kinematics import (
     VY,
     X,
     Y,
-    minimum_image,
-    wrap,
 )
 from sim.engine.parameters import per_disk
 from sim.engine.prefetch import prefetch
@@ -131,9 +129,7 @@ def _shells_overlap(cx, cy, i, j, table, delta, box):
     changes sign with the order, so the test gives the same answer for (i, j) and (j, i) to the
     last bit: the lists hold exactly the overlapping pairs, which the rebuild relies on.
     """
-    geometry, grid = box.geometry, box.grid
-    dx = minimum_image(cx - table[j, CX], geometry[SIDE], grid[PERIODIC] != 0)
-    dy = minimum_image(cy - table[j, CY], geometry[SIDE + 1], grid[PERIODIC + 1] != 0)
+    dx, dy = separation(box, cx - table[j, CX], cy - table[j, CY])
     reach_i = table[i, RADIUS] + per_disk(delta, i)
     reach_j = table[j, RADIUS] + per_disk(delta, j)
     reach = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
@@ -291,7 +287,7 @@ def prefetch_cells(x, y, members, table, cell_head, cell_next, geometry, grid):
 
 
 @njit(cache=True, inline="always")
-def shell_centre(i, table, delta, geometry, grid):
+def shell_centre(i, table, delta, box):
     """Centre (cx, cy) of a new shell for disk i: ahead of the disk along its velocity by
     λ δ_i, λ = ``geometry[LEAD]`` < 1, wrapped into a periodic box.
 
@@ -303,10 +299,9 @@ def shell_centre(i, table, delta, geometry, grid):
     vx = table[i, VX]
     vy = table[i, VY]
     speed_squared = vx * vx + vy * vy
-    lead = (geometry[LEAD] * per_disk(delta, i) / math.sqrt(speed_squared)
+    lead = (box.geometry[LEAD] * per_disk(delta, i) / math.sqrt(speed_squared)
             if speed_squared > TINY_SPEED_SQUARED else 0.0)
-    return (wrap(table[i, X] + lead * vx, geometry[SIDE], grid[PERIODIC] != 0),
-            wrap(table[i, Y] + lead * vy, geometry[SIDE + 1], grid[PERIODIC + 1] != 0))
+    return fold(box, table[i, X] + lead * vx, 0), fold(box, table[i, Y] + lead * vy, 1)
 
 
 @njit(cache=True, inline="always")
@@ -335,7 +330,7 @@ def rebuild_neighbours(i, table, delta, neighbours, box, hint_candidates):
     """
     nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
     cell_of = neighbours.cell_of
-    cx, cy = shell_centre(i, table, delta, box.geometry, box.grid)
+    cx, cy = shell_centre(i, table, delta, box)
     start = list_start(nb_start, i)
     old = nb_count[i]
     found = _find_new_neighbours((np.int64(i), cx, cy, table[i, CX], table[i, CY], np.int64(0)),

@@ -42,7 +42,7 @@ class Running:
             d = self.disks
             every = self.reorder_every
             reorder_at = (self.counters[codes.EVENTS] // every + 1) * every
-            parts = Parts(self.system_event)
+            parts = Parts(self.pair_interaction, self.system_event)
             arguments = (
                 Disks(d.table, *self._per_disk_parameters(), d.stamp, d.counted, d.contacts,
                       d.t_last, d.streak),

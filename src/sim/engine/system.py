@@ -84,7 +84,7 @@ def advance_all(t, disks, box, effects):
     """Bring every disk to time t (relative clock) along its path."""
     table = disks.table
     for i in range(table.shape[0]):
-        fly(i, t, table, box.geometry, box.grid, effects.gravity, effects.images)
+        fly(i, t, table, box, effects.gravity, effects.images)
 
 
 @njit(cache=True, inline="always")

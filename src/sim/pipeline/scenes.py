@@ -18,6 +18,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from sim.effects.values import MAX_DISKS, ConfigError, pair, positive, resolvable, within
+from sim.engine.box import nearest_images
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
@@ -228,9 +229,7 @@ def _check_two_disks(c):
     if c.disks.radius is None:
         raise ConfigError("disks.radius", None, "the radius of the two disks")
     box = np.array([float(x) for x in c.box.size])
-    r = position[0] - position[1]
-    if c.box.boundary == "periodic":
-        r -= box * np.round(r / box)
+    r = nearest_images(position[0] - position[1], box, [c.box.boundary == "periodic"] * 2)
     if np.hypot(*r) < 2.0 * c.disks.radius:
         raise ConfigError("two_disks.positions", position.tolist(),
                           f"two points [[x, y], [x, y]] at least 2 R = "

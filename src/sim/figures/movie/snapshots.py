@@ -26,6 +26,7 @@ import numpy as np
 import yaml
 
 from sim.effects.gravity import gravity_vector
+from sim.engine.box import folded
 from sim.pipeline.command import BadInput
 
 #: the longest movie made by default, one frame per snapshot (seconds)
@@ -49,7 +50,7 @@ def free_flight(position, velocity, elapsed, gravity=None, box=None, periodic=(F
     acceleration = np.zeros(2) if gravity is None else np.asarray(gravity, dtype=np.float64)
     moved = position + velocity * elapsed + 0.5 * acceleration * elapsed**2
     if any(periodic):
-        moved = np.where(periodic, np.mod(moved, box), moved)
+        moved = folded(moved, box, periodic)
     return moved, velocity + acceleration * elapsed
 
 
