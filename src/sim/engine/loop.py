@@ -87,7 +87,12 @@ from sim.engine.kinematics import (
 )
 from sim.engine.lookahead import prefetch_upcoming
 from sim.engine.neighbours import list_start, rebuild_neighbours
-from sim.engine.pairs import apply_pair_event, pair_event_time
+from sim.engine.pairs import (
+    apply_pair_event,
+    collide,
+    own_apply,
+    pair_event_time,
+)
 from sim.engine.parameters import per_disk
 from sim.engine.queue import (
     build_queue,
@@ -326,9 +331,13 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
             fly(j, t, disks.table, box, effects.gravity, effects.images)
             collisions += 1
             events += 1
-            lost, virial, log_full, culprit = apply_pair_event(
-                parts.pair, i, j, t, t_origin, disks, box, effects, tallies,
-                collisions + wall_contacts)
+            if own_apply(parts.pair):
+                lost, virial, log_full, culprit = apply_pair_event(
+                    parts.pair, i, j, t, t_origin, disks, box, effects, tallies,
+                    collisions + wall_contacts)
+            else:
+                lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
+                                                          tallies, collisions + wall_contacts)
             dissipated_disks += lost
             virial_sum += virial
         elif partner == SHELL_EXIT:

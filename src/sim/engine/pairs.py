@@ -1,10 +1,11 @@
 """Pair interactions: when two neighbouring disks next have an event, and what it does.
 
 The loop asks every neighbour pair of a disk it predicts for the time of their next pair event
-(:func:`pair_event_time`) and applies the earliest (:func:`apply_pair_event`). By default
-(``Parts.pair`` None, :mod:`sim.engine.groups`) the pair is two hard disks: their contact at
-σ_ij = R_i + R_j, the filter and the root of :mod:`sim.engine.kinematics`, and the impulse
-of :func:`collide` (restitution, the TC model, rough disks, the recorders).
+and applies the earliest. By default (``Parts.pair`` None, :mod:`sim.engine.groups`) the pair
+is two hard disks: their contact at σ_ij = R_i + R_j (:func:`hard_core_time`, the filter and
+the root of :mod:`sim.engine.kinematics`) and the impulse of :func:`collide` (restitution,
+the TC model, rough disks, the recorders); otherwise the rules of the pair's kind
+(:func:`pair_event_time`, and :func:`apply_pair_event` when :func:`own_apply`).
 
 A kind of pair interaction is a NamedTuple class (its value: the constants of the rule) with
 compiled rules registered for it by :func:`rules`; numba picks them by the value's type while
@@ -58,43 +59,61 @@ def _rules_of(value):
     return RULES[kind]
 
 
+def own_apply(pair):
+    """Whether ``pair`` applies its events by a rule of its own kind (else :func:`collide`).
+    A constant while numba compiles the loop, which calls :func:`collide` directly when it is
+    False: the contact is then compiled as it was before the seam existed (through an
+    overload it took 3 s more of the first compilation)."""
+    return pair is not None and RULES[type(pair)][1] is not None
+
+
+@overload(own_apply, inline="always")
+def _own_apply(pair):
+    own = pair is not types.none and _rules_of(pair)[1] is not None
+    return lambda pair: own
+
+
+@njit(cache=True, inline="always")
+def hard_core_time(rx, ry, vx, vy, sigma, tau):
+    """The hard core's event time: the contact at σ
+    (:func:`sim.engine.kinematics.pair_contact_time`), or ∞ when the filter
+    (:func:`sim.engine.kinematics.may_touch_before`) shows that it comes no sooner than τ."""
+    if may_touch_before(rx, ry, vx, vy, sigma, tau):
+        return pair_contact_time(rx, ry, vx, vy, sigma)
+    return INF
+
+
 def pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, disks):
-    """The time until disks i and j next have a pair event (see the module docstring)."""
+    """The time until disks i and j next have a pair event: the rule of ``pair``'s kind (see
+    the module docstring), or :func:`hard_core_time`."""
     if pair is None:
-        if may_touch_before(rx, ry, vx, vy, sigma, tau):
-            return pair_contact_time(rx, ry, vx, vy, sigma)
-        return INF
+        return hard_core_time(rx, ry, vx, vy, sigma, tau)
     return RULES[type(pair)][0](pair, i, j, rx, ry, vx, vy, sigma, tau, disks)
 
 
 @overload(pair_event_time, inline="always")
 def _pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, disks):
     if pair is types.none:
-        def hard_core(pair, i, j, rx, ry, vx, vy, sigma, tau, disks):
-            if may_touch_before(rx, ry, vx, vy, sigma, tau):
-                return pair_contact_time(rx, ry, vx, vy, sigma)
-            return INF
-        return hard_core
+        return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, disks: hard_core_time(
+            rx, ry, vx, vy, sigma, tau)
     event_time = _rules_of(pair)[0]
     return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, disks: event_time(
         pair, i, j, rx, ry, vx, vy, sigma, tau, disks)
 
 
 def apply_pair_event(pair, i, j, t, t_origin, disks, box, effects, tallies, contact):
-    """Apply the pair event of disks i and j at time t, the run's ``contact``-th contact: the
-    rule of ``pair``'s kind, or :func:`collide`. Returns what :func:`collide` returns."""
-    apply = RULES[type(pair)][1] if pair is not None else None
-    if apply is None:
-        return collide(i, j, t, t_origin, disks, box, effects, tallies, contact)
-    return apply(pair, i, j, t, t_origin, disks, box, effects, tallies, contact)
+    """Apply the pair event of disks i and j at time t, the run's ``contact``-th contact, by
+    the rule of ``pair``'s kind; the loop calls it when :func:`own_apply`. Returns what
+    :func:`collide` returns."""
+    return RULES[type(pair)][1](pair, i, j, t, t_origin, disks, box, effects, tallies, contact)
 
 
 @overload(apply_pair_event, inline="always")
 def _apply_pair_event(pair, i, j, t, t_origin, disks, box, effects, tallies, contact):
     apply = None if pair is types.none else _rules_of(pair)[1]
-    if apply is None:
-        return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: collide(
-            i, j, t, t_origin, disks, box, effects, tallies, contact)
+    if apply is None:  # typed, never called
+        return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: (
+            0.0, 0.0, False, -1)
     return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: apply(
         pair, i, j, t, t_origin, disks, box, effects, tallies, contact)
 
