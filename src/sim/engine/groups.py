@@ -1,9 +1,9 @@
 """The arguments of the compiled loop, in named groups.
 
-:func:`sim.engine.loop.run_events` takes eight tuples: what it reads and writes of the disks,
+:func:`sim.engine.loop.run_events` takes seven tuples: what it reads and writes of the disks,
 the schedule of their events, the neighbour lists and cells, the box, the effects
-(:class:`sim.effects.Effects`), the parts a scene may replace, the running tallies and the
-limits of one call. numba
+(:class:`sim.effects.Effects`), the running tallies and the limits of one call; and the
+values of the parts a scene may replace (:class:`Parts`) one by one. numba
 passes a tuple's fields as separate arguments, so grouping costs nothing; fields are read by
 name, and a field that is a number where it could be an array (a mass every disk shares, one
 list capacity for all) compiles a variant that never loads the array
@@ -65,7 +65,8 @@ class Parts(NamedTuple):
     """The parts of the dynamics a scene may replace, by kind, each None for none (or the
     default): a value of a kind registered with its module, whose rules numba picks by the
     value's type. A kind may be defined outside sim, so no cached function but the loop takes
-    this group (:func:`sim.engine.compilation.cacheable`)."""
+    these values (:func:`sim.engine.compilation.cacheable`); the loop takes them one by one
+    (:func:`sim.engine.loop.run_events`)."""
     pair: object  # the pair interaction (sim.engine.pairs); None: hard disks
     system: object  # the system event (sim.engine.system)
 

@@ -101,11 +101,11 @@ from sim.engine.queue import (
     reschedule,
 )
 from sim.engine.stamps import count_contacts
-from sim.engine.system import apply_system_event, system_due
+from sim.engine.system import apply_system_event
 
 
 @njit(cache=True, inline="always")
-def predict(i, t, disks, schedule, neighbours, box, effects, parts, t_origin):
+def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
     """The earliest event of disk i, which must be at time t already (``t_origin``: the
     absolute time of the clock's zero, which moving walls need): its time, its partner (a
     disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's staleness stamp when
@@ -153,7 +153,7 @@ def predict(i, t, disks, schedule, neighbours, box, effects, parts, t_origin):
                             y - table[j, Y] - flown(j, 1, dt, table, gravity))
         vx_ij = vx - vx_j
         vy_ij = vy - vy_j
-        tau_ij = pair_event_time(parts.pair, i, j, rx, ry, vx_ij, vy_ij, r_i + table[j, RADIUS],
+        tau_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij, r_i + table[j, RADIUS],
                                  tau, disks)
         if tau_ij < tau and t + tau_ij <= event_time[j]:
             tau = tau_ij
@@ -215,7 +215,7 @@ def rebase_clock(disks, schedule, box, effects, accumulators):
 
 
 @njit(cache=True, inline="always")
-def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, parts, t_origin):
+def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, pair, t_origin):
     """Predict the next event of disk i and, when j ≥ 0, of disk j, and file both.
 
     One call site each for predict and reschedule: numba inlines them wherever they are
@@ -229,7 +229,7 @@ def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, parts, 
     when, whom, whose_stamp = INF, NO_EVENT, np.int32(0)
     for k in range(moved_disks):
         when, whom, whose_stamp = predict(i if k == 0 else j, t, disks, schedule, neighbours,
-                                          box, effects, parts, t_origin)
+                                          box, effects, pair, t_origin)
         prefetch_bucket(s.list_head, s.calendar, s.block_rate, when)
         if k == 0:
             set_event(i, when, whom, whose_stamp, schedule)
@@ -274,9 +274,14 @@ def stop_status(limits, partner, t, t_stop, t_previous, stalled, stall_limit, ev
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits):
+def run_events(disks, schedule, neighbours, box, effects, pair, system, tallies, limits):
     """Process events in time order until :func:`stop_status` ends the loop; see the module
     docstring. Returns (status, the disk it concerns or −1).
+
+    ``pair`` and ``system`` are the fields of :class:`sim.engine.groups.Parts`, passed one by
+    one: numba prunes a branch ``if system is not None`` only for an argument of the function
+    it compiles, so that a scene without a system event compiles none of its code (0.7 s of
+    the first compilation, against the group).
 
     ``tallies.stall_watch`` carries the time of the last event popped (relative clock) and
     the length of its stall run from one call to the next; counters and accumulators live in
@@ -309,7 +314,7 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
         i = earliest(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time)
         partner = s.event_partner[i]
         t = s.event_time[i]
-        if system_due(parts.system, s.system_time, t):
+        if system is not None and s.system_time[0] <= t:
             partner = SYSTEM
             t = s.system_time[0]
         status, stalled = stop_status(limits, partner, t, t_stop, t_previous, stalled,
@@ -331,9 +336,9 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
             fly(j, t, disks.table, box, effects.gravity, effects.images)
             collisions += 1
             events += 1
-            if own_apply(parts.pair):
+            if pair is not None and own_apply(pair):
                 lost, virial, log_full, culprit = apply_pair_event(
-                    parts.pair, i, j, t, t_origin, disks, box, effects, tallies,
+                    pair, i, j, t, t_origin, disks, box, effects, tallies,
                     collisions + wall_contacts)
             else:
                 lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
@@ -348,8 +353,8 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
                 break
             shell_exits += 1
             events += 1
-        elif partner == SYSTEM:  # i, at the head of the queue, was flown to t: no matter
-            s.system_time[0] = apply_system_event(parts.system, t, t_origin, disks, schedule,
+        elif system is not None and partner == SYSTEM:  # i (the queue's head) flown to t: harmless
+            s.system_time[0] = apply_system_event(system, t, t_origin, disks, schedule,
                                                   neighbours, box, effects)
             t_now = t
             continue
@@ -365,7 +370,7 @@ def run_events(disks, schedule, neighbours, box, effects, parts, tallies, limits
         if culprit >= 0:
             status = STATUS_COLLAPSE
             break
-        predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, parts, t_origin)
+        predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, pair, t_origin)
         if (partner >= 0 and j < 0) or partner == UNPREDICTED:
             continue  # a stale event or a first prediction is no event: the clock stays
         t_now = t

@@ -111,7 +111,7 @@ def apply_pair_event(pair, i, j, t, t_origin, disks, box, effects, tallies, cont
 @overload(apply_pair_event, inline="always")
 def _apply_pair_event(pair, i, j, t, t_origin, disks, box, effects, tallies, contact):
     apply = None if pair is types.none else _rules_of(pair)[1]
-    if apply is None:  # typed, never called
+    if apply is None:  # typed for a kind without an apply rule of its own, never called
         return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: (
             0.0, 0.0, False, -1)
     return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: apply(

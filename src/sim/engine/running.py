@@ -50,7 +50,7 @@ class Running:
                 self._neighbours(),
                 Box(self.geometry, self.grid),
                 self._effects(),
-                parts,
+                *parts,
                 Tallies(self.counters, self.accumulators, self.pair_collisions,
                         self.wall_impulse, self.stall_watch),
                 Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,

@@ -4,9 +4,10 @@ velocities, a thermostat's kick, a new epoch of a sliding boundary), not to one 
 A system event lives outside the disks' calendar, in the schedule's slot
 (``Schedule.system_time`` float64[1], on the loop's relative clock; its value is
 ``Parts.system``, :mod:`sim.engine.groups`): before each event the loop compares the slot's
-time with the head of the queue (:func:`system_due`), and a system event comes first at
-equal times. With no system event (``system`` None) the comparison is compiled away, and the
-order of disk events, ties included, is that of a loop without the slot.
+time with the head of the queue, and a system event comes first at equal times. With no
+system event (``system`` None, an argument of the loop, whose branches numba prunes while it
+compiles) the comparison is compiled away, and the order of disk events, ties included, is
+that of a loop without the slot.
 
 A kind of system event is a NamedTuple class (its value: the constants its handler needs)
 and a compiled handler registered for it with :func:`handler`; numba picks the handler by the
@@ -22,9 +23,8 @@ predictions no longer hold: :func:`predict_all` for every disk, or for a few dis
 :func:`sim.engine.stamps.invalidate` and :func:`repredict` each.
 """
 
-import math
 
-from numba import njit, types
+from numba import njit
 from numba.core.errors import TypingError
 from numba.extending import overload
 
@@ -45,18 +45,6 @@ def handler(kind):
     return register
 
 
-def system_due(system, system_time, t):
-    """Whether the system event comes before the disk event at time t (never without one)."""
-    return system is not None and system_time[0] <= t
-
-
-@overload(system_due, inline="always")
-def _system_due(system, system_time, t):
-    if system is types.none:
-        return lambda system, system_time, t: False
-    return lambda system, system_time, t: system_time[0] <= t
-
-
 def apply_system_event(system, t, t_origin, disks, schedule, neighbours, box, effects):
     """Call the handler of ``system``'s kind; returns the time of the next system event."""
     return HANDLERS[type(system)](system, t, t_origin, disks, schedule, neighbours, box,
@@ -65,8 +53,6 @@ def apply_system_event(system, t, t_origin, disks, schedule, neighbours, box, ef
 
 @overload(apply_system_event)
 def _apply_system_event(system, t, t_origin, disks, schedule, neighbours, box, effects):
-    if system is types.none:  # typed, never called (system_due)
-        return lambda system, t, t_origin, disks, schedule, neighbours, box, effects: math.inf
     kind = getattr(system, "instance_class", None)
     if kind not in HANDLERS:
         raise TypingError(f"no system-event handler is registered for {system} "
