@@ -23,7 +23,6 @@ predictions no longer hold: :func:`predict_all` for every disk, or for a few dis
 :func:`sim.engine.stamps.invalidate` and :func:`repredict` each.
 """
 
-
 from numba import njit
 from numba.core.errors import TypingError
 from numba.extending import overload
@@ -46,9 +45,11 @@ def handler(kind):
 
 
 def apply_system_event(system, t, t_origin, disks, schedule, neighbours, box, effects):
-    """Call the handler of ``system``'s kind; returns the time of the next system event."""
-    return HANDLERS[type(system)](system, t, t_origin, disks, schedule, neighbours, box,
-                                  effects)
+    """Call the handler of ``system``'s kind; returns the time of the next system event, no
+    earlier than t."""
+    later = HANDLERS[type(system)](system, t, t_origin, disks, schedule, neighbours, box,
+                                   effects)
+    return later if later >= t else t
 
 
 @overload(apply_system_event)
