@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from numba import njit
 
-from sim.engine import Boundary, Engine
+from conftest import gas
+from sim.engine.box import nearest_images
 from sim.engine.kinematics import INF, may_touch_before, pair_contact_time
 from sim.engine.pairs import rules
 from sim.engine.parameters import per_disk
@@ -36,25 +37,19 @@ def soft_core_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, disks):
 rules(SoftCore, soft_core_event_time)
 
 N = 400
-RADIUS = np.sqrt(0.4 / (np.pi * N))  # φ = 0.4
 
 
 def mixture(pair_interaction):
-    """N equal disks of two species in a periodic box of side 1, on a jittered lattice."""
-    rng = np.random.default_rng(3)
-    side = int(np.sqrt(N))
-    grid = (np.arange(side) + 0.5) / side
-    position = np.stack(np.meshgrid(grid, grid), axis=-1).reshape(-1, 2)
-    position += rng.uniform(-0.2, 0.2, position.shape) * (1.0 / side - 2 * RADIUS)
-    return Engine(position, rng.normal(size=(N, 2)), RADIUS, species=np.arange(N) % 2,
-                  boundary=Boundary(periodic=(True, True)), pair_interaction=pair_interaction)
+    """N equal disks of two species, alternating, at φ = 0.4 in a periodic box of side 1."""
+    return gas(N, 0.4, periodic=(True, True), seed=3, species=np.arange(N) % 2,
+               pair_interaction=pair_interaction)
 
 
 def closest(engine):
-    """The smallest distance over σ_ij of like pairs and of unlike pairs (minimum image)."""
-    r = engine.positions()[:, None, :] - engine.positions()[None, :, :]
-    r -= np.round(r)
-    distance = np.hypot(r[..., 0], r[..., 1]) / (2 * RADIUS)
+    """The smallest distance over σ_ij of like pairs and of unlike pairs (nearest images)."""
+    r = nearest_images(engine.positions()[:, None, :] - engine.positions()[None, :, :],
+                       engine.box, engine.periodic)
+    distance = np.hypot(r[..., 0], r[..., 1]) / (2 * engine.radius[0])
     np.fill_diagonal(distance, np.inf)
     unlike = (np.arange(N)[:, None] % 2) != (np.arange(N)[None, :] % 2)
     return distance[~unlike].min(), distance[unlike].min()
@@ -64,7 +59,7 @@ def test_unlike_disks_touch_at_their_softer_core_and_like_disks_never_overlap():
     engine = mixture(SoftCore(0.6))
     energy = engine.kinetic_energy()
     like, unlike = [], []
-    for end in np.linspace(0.02, 0.4, 20):
+    for end in np.linspace(0.03, 0.6, 20):
         engine.run(time=end)
         closest_like, closest_unlike = closest(engine)
         like.append(closest_like)

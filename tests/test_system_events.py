@@ -12,8 +12,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from sim.checks.audit import overlapping_pairs
-from sim.engine import Boundary, Engine
+from conftest import assert_no_overlap, gas
 from sim.engine.flight import fly
 from sim.engine.kinematics import VX, VY
 from sim.engine.stamps import invalidate
@@ -53,21 +52,14 @@ def toy(value, t, t_origin, disks, schedule, neighbours, box, effects):
     return t + value.at
 
 
-def gas(mode, at, n=400, phi=0.3, seed=1):
-    """A periodic gas of n equal disks at packing fraction phi on a jittered square lattice."""
-    rng = np.random.default_rng(seed)
-    side = int(np.ceil(np.sqrt(n)))
-    radius = np.sqrt(phi / (np.pi * n))
-    grid = (np.arange(side) + 0.5) / side
-    position = np.stack(np.meshgrid(grid, grid), axis=-1).reshape(-1, 2)[:n]
-    position += rng.uniform(-0.2, 0.2, position.shape) * (1.0 / side - 2 * radius)
-    velocity = rng.normal(size=(n, 2))
-    return Engine(position, velocity, radius, boundary=Boundary(periodic=(True, True)),
-                  system_event=Toy(mode, at, np.zeros(1, np.int64)))
+def toy_gas(mode, at):
+    """A periodic gas of 400 equal disks at φ = 0.3 with the toy system event."""
+    return gas(400, 0.3, periodic=(True, True), seed=1,
+               system_event=Toy(mode, at, np.zeros(1, np.int64)))
 
 
 def test_a_reversed_gas_retraces_its_path():
-    engine = gas(REVERSE, at=0.1)
+    engine = toy_gas(REVERSE, at=0.1)
     start = engine.positions(0.0)
     engine.run(time=0.1)
     forward = engine.collisions
@@ -80,13 +72,11 @@ def test_a_reversed_gas_retraces_its_path():
 
 
 def test_a_kicked_disk_is_never_counted_as_a_contact_and_never_overlaps():
-    engine = gas(TURN, at=0.01)
+    engine = toy_gas(TURN, at=0.01)
     energy = engine.kinetic_energy()
     for end in np.linspace(0.05, 0.5, 10):
         engine.run(time=end)
-        pairs, _ = overlapping_pairs(engine.positions(), engine.radius, engine.box,
-                                     engine.periodic)
-        assert pairs.size == 0
+        assert_no_overlap(engine)
     assert engine.system_event.applied[0] == 49
     assert engine.contacts_by_disk().sum() == 2 * engine.collisions
     assert engine.kinetic_energy() == pytest.approx(energy, rel=1e-12)
@@ -97,13 +87,13 @@ def _fingerprint(engine):
 
 
 def test_system_events_keep_the_bits_across_chunks_and_checkpoints():
-    whole = gas(TURN, at=0.01)
+    whole = toy_gas(TURN, at=0.01)
     whole.run(time=0.3)
-    chunked = gas(TURN, at=0.01)
+    chunked = toy_gas(TURN, at=0.01)
     chunked.run(time=0.3, chunk_events=97)
-    half = gas(TURN, at=0.01)
+    half = toy_gas(TURN, at=0.01)
     half.run(time=0.15)
-    resumed = gas(TURN, at=0.01)
+    resumed = toy_gas(TURN, at=0.01)
     resumed.load_state_dict(half.state_dict())
     resumed.run(time=0.3)
     assert _fingerprint(chunked) == _fingerprint(whole) == _fingerprint(resumed)

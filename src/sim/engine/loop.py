@@ -33,7 +33,6 @@ the code of every effect that is off. It returns ``(status, disk)``; errors are 
 as exceptions by the caller.
 """
 
-
 import numpy as np
 from numba import njit
 

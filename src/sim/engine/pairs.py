@@ -60,16 +60,17 @@ def _rules_of(value):
 
 
 def own_apply(pair):
-    """Whether ``pair`` applies its events by a rule of its own kind (else :func:`collide`).
-    A constant while numba compiles the loop, which calls :func:`collide` directly when it is
-    False: the contact is then compiled as it was before the seam existed (through an
-    overload it took 3 s more of the first compilation)."""
-    return pair is not None and RULES[type(pair)][1] is not None
+    """Whether the pair interaction ``pair`` (not None) applies its events by a rule of its
+    own kind, else :func:`collide`. A constant while numba compiles the loop, which calls
+    :func:`collide` directly when it is False or ``pair`` None: the contact is then compiled
+    as it was before the seam existed (through an overload it took 3 s more of the first
+    compilation)."""
+    return RULES[type(pair)][1] is not None
 
 
 @overload(own_apply, inline="always")
 def _own_apply(pair):
-    own = pair is not types.none and _rules_of(pair)[1] is not None
+    own = _rules_of(pair)[1] is not None
     return lambda pair: own
 
 

@@ -17,13 +17,19 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
+def _count(i, stamp, counted, contacts):
+    """Add to disk i's contacts the bumps of its stamp since it was last counted (modulo 2³²,
+    so correct while no disk makes 2³² contacts between two counts)."""
+    contacts[i] += (np.int64(stamp[i]) - counted[i]) & 0xFFFFFFFF
+    counted[i] = stamp[i]
+
+
+@njit(cache=True, inline="always")
 def count_contacts(stamp, counted, contacts):
     """Bring the full contact counts ``contacts`` up to date with the stamps: every bump since
-    the stamp was last counted is a contact (modulo 2³², so correct while no disk makes 2³²
-    contacts between two calls; the loop calls it at every clock rebase)."""
+    a stamp was last counted is a contact (the loop calls it at every clock rebase)."""
     for i in range(stamp.shape[0]):
-        contacts[i] += (np.int64(stamp[i]) - counted[i]) & 0xFFFFFFFF
-        counted[i] = stamp[i]
+        _count(i, stamp, counted, contacts)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -35,6 +41,6 @@ def count_all_contacts(stamp, counted, contacts):
 @njit(cache=True, inline="always")
 def invalidate(i, disks):
     """Make every prediction with disk i as partner stale, without counting a contact."""
-    disks.contacts[i] += (np.int64(disks.stamp[i]) - disks.counted[i]) & 0xFFFFFFFF
+    _count(i, disks.stamp, disks.counted, disks.contacts)
     disks.stamp[i] += 1
     disks.counted[i] = disks.stamp[i]

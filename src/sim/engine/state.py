@@ -36,9 +36,8 @@ from sim.engine.neighbours import copy_lists, list_starts
 from sim.engine.queue import NEXT, PREV
 
 PER_DISK = ("table", "delta", "mass", "species", "is_big", "stamp", "counted", "contacts",
-            "t_last",
-            "streak", "event_time", "event_partner", "event_stamp", "links", "nb_start", "nb_cap",
-            "nb_count", "cell_next", "cell_prev", "cell_of", "order")
+            "t_last", "streak", "event_time", "event_partner", "event_stamp", "links",
+            "nb_start", "nb_cap", "nb_count", "cell_next", "cell_prev", "cell_of", "order")
 
 CACHE_LINE = 64
 HUGE_PAGE = 2 << 20

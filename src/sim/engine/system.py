@@ -12,7 +12,8 @@ that of a loop without the slot.
 A kind of system event is a NamedTuple class (its value: the constants its handler needs)
 and a compiled handler registered for it with :func:`handler`; numba picks the handler by the
 value's type while it compiles the loop (a registry filled at import: the loop's cached
-variants key on the value's type, and a second start compiles nothing). The first event is
+variants key on the value's type, and a second start compiles nothing; a kind defined outside
+sim runs an uncached loop, :func:`sim.engine.compilation.cacheable`). The first event is
 due at the start of the run (t = 0 on the engine's clock); the handler is called as
 ``f(value, t, t_origin, disks, schedule, neighbours, box, effects)`` with the loop's groups
 (:mod:`sim.engine.groups`; ``t`` on the relative clock, ``t_origin`` the absolute time of its
