@@ -26,12 +26,12 @@ class SoftCore(NamedTuple):
 
 
 @njit
-def soft_core_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, disks):
+def soft_core_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     if per_disk(disks.species, i) != per_disk(disks.species, j):
         sigma = value.scale * sigma
     if may_touch_before(rx, ry, vx, vy, sigma, tau):
-        return pair_contact_time(rx, ry, vx, vy, sigma)
-    return INF
+        return pair_contact_time(rx, ry, vx, vy, sigma), 0
+    return INF, 0
 
 
 rules(SoftCore, soft_core_event_time)

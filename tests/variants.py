@@ -14,22 +14,26 @@ Budget: a new effect or interaction adds at most one canonical variant (its scen
 that needs another combination is ``slow``.
 
 The canonical variants in :class:`sim.engine.Engine` terms (the box's walls or periodic
-sides, N, the values of the effects and of the disks do not change the variant; every disk
-alike means one mass, one species and one radius):
+sides, the values of the effects and of the disks do not change the variant; N does only
+through the look-ahead of states larger than the caches, from
+:data:`sim.engine.sizing.LOOKAHEAD_MIN_DISKS` disks on, which a test may switch on for fewer;
+every disk alike means one mass, one species and one radius):
 
-==============  ================================================================================
-gas             no effect, every disk alike
-mixture         no effect, masses and species per disk (radii may differ too)
-cooling         ``restitution`` < 1 and ``tc`` > 0; every disk alike
-driven          ``restitution`` < 1 and a thermal wall (``walls={...: {"temperature": T}}``)
-vibrated_bed    ``restitution``, ``wall_restitution`` < 1, ``tc``, ``gravity`` and a moving or
-                vibrating wall
-crater          ``restitution``, ``wall_restitution``, ``tc``; masses and species per disk and
-                one disk far larger than the rest (list capacities per disk)
-settling_bed    ``restitution``, ``wall_restitution``, ``tc`` and ``gravity``, every disk alike
-rough_cooling   ``restitution``, ``tangential_restitution`` (rough, no friction) and ``tc``
-observers       ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk alike
-==============  ================================================================================
+================  ==============================================================================
+gas               no effect, every disk alike
+mixture           no effect, masses and species per disk (radii may differ too)
+cooling           ``restitution`` < 1 and ``tc`` > 0; every disk alike
+driven            ``restitution`` < 1 and a thermal wall (``walls={...: {"temperature": T}}``)
+vibrated_bed      ``restitution``, ``wall_restitution`` < 1, ``tc``, ``gravity`` and a moving or
+                  vibrating wall
+crater            ``restitution``, ``wall_restitution``, ``tc``; masses and species per disk and
+                  one disk far larger than the rest (list capacities per disk)
+settling_bed      ``restitution``, ``wall_restitution``, ``tc`` and ``gravity``, every disk alike
+rough_cooling     ``restitution``, ``tangential_restitution`` (rough, no friction) and ``tc``
+observers         ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk alike
+gas_lookahead     gas, looking ahead
+crater_lookahead  crater, looking ahead
+================  ==============================================================================
 """
 
 import json
@@ -74,7 +78,10 @@ CANONICAL = {**{scene: (scene,) for scene in ("gas", "mixture", "cooling", "driv
                                                "vibrated_bed", "crater", "rough_cooling")},
              "settling_bed": ("gas", "gravity=[0,-1]", "restitution.disk=0.9",
                               "restitution.wall=0.9", "tc.time=1e-4"),
-             "observers": ("gas", *OBSERVERS)}
+             "observers": ("gas", *OBSERVERS),
+             "gas_lookahead": ("gas",), "crater_lookahead": ("crater",)}
+#: the canonical variants that look ahead (``Engine.lookahead``), whatever their N
+LOOKAHEAD = ("gas_lookahead", "crater_lookahead")
 
 
 def compose_scene(name, *overrides):
@@ -108,13 +115,14 @@ def describe(signature):
         return dict(zip(group.fields, group.types, strict=True))
 
     disks, neighbours, effects = (named(signature[k]) for k in (0, 2, 4))
+    ahead = "" if signature[7] == types.none else "; looking ahead"
     per_disk = [name for name in ("delta", "mass", "species")
                 if isinstance(disks[name], types.Array)]
     if isinstance(neighbours["nb_cap"], types.Array):
         per_disk.append("list capacity")
     on = [name for name, kind in effects.items() if kind != types.none and name != "seed"]
-    return (f"effects: {', '.join(on) or 'none'}; per disk: {', '.join(per_disk) or 'none'}; "
-            f"types: {signature}")
+    return (f"effects: {', '.join(on) or 'none'}; per disk: {', '.join(per_disk) or 'none'}"
+            f"{ahead}; types: {signature}")
 
 
 def warm(names):
@@ -125,7 +133,9 @@ def warm(names):
     for name in names:
         before = compiled().keys()
         scene, *overrides = CANONICAL[name]
-        build_engine(compose_scene(scene, *overrides)).run(contacts=200)
+        engine = build_engine(compose_scene(scene, *overrides))
+        engine.lookahead = name in LOOKAHEAD
+        engine.run(contacts=200)
         made[name] = sorted(compiled().keys() - before)
     return made
 

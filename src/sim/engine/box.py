@@ -9,11 +9,11 @@
 
 Walls are numbered ``2 axis + side`` (0 x-low, 1 x-high, 2 y-low, 3 y-high).
 
-The boundary: every compiled function that needs the separation of two points or a position
-inside the box asks :func:`separation` and :func:`fold` with the loop's ``box`` group
-(:class:`sim.engine.groups.Box`), so that another boundary (a sliding one) changes these two
-and nothing else; Python that measures positions of a run (analysis, the audit, export,
-movies) asks :func:`nearest_images` and :func:`folded`.
+The boundary: every compiled function that needs the separation of two points, the velocity
+of an image or a position inside the box asks :func:`separation`, :func:`image_velocity` and
+:func:`fold` with the loop's ``box`` group (:class:`sim.engine.groups.Box`), so that another
+boundary (a sliding one) changes these three and nothing else; Python that measures positions
+of a run (analysis, the audit, export, movies) asks :func:`nearest_images` and :func:`folded`.
 """
 
 import numpy as np
@@ -42,6 +42,16 @@ def separation(box, dx, dy):
     walls."""
     return (minimum_image(dx, box.geometry[SIDE], box.grid[PERIODIC] != 0),
             minimum_image(dy, box.geometry[SIDE + 1], box.grid[PERIODIC + 1] != 0))
+
+
+@njit(cache=True, inline="always")
+def image_velocity(box, dy, ry):
+    """The velocity (u_x, u_y) of the image through which a point at separation dy along y
+    (before :func:`separation`, ``ry`` after) is seen, relative to the point itself: the
+    relative velocity of a pair is v_i − v_j − u. Zero between walls and across periodic
+    sides, whose images rest; a sliding (Lees–Edwards) boundary gives the images across its
+    y sides the shear velocity, ±γ̇ L_y per side crossed ((dy − ry) / L_y of them)."""
+    return 0.0, 0.0
 
 
 @njit(cache=True, inline="always")

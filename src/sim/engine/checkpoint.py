@@ -28,6 +28,10 @@ def upgraded(state):
     return state
 
 
+#: arrays whose size changes as the neighbour lists grow
+GROWING = ("disks/nb", "disks/pair_state")
+
+
 class Checkpoints:
     """Save and restore the evolving state (the engine's checkpointing part)."""
 
@@ -48,9 +52,9 @@ class Checkpoints:
     def load_state_dict(self, state):
         """Replace the evolving arrays by those of :meth:`state_dict` (copied). A state of
         another scene — other arrays, or arrays of other shapes than this engine's (the
-        neighbour lists ``disks/nb`` aside, which grow) — is refused with a ValueError before
-        anything is replaced. A checkpoint of sim 0.1.0 is read as one of today
-        (:func:`upgraded`)."""
+        neighbour lists ``disks/nb`` and their pairs' states ``disks/pair_state`` aside, which
+        grow) — is refused with a ValueError before anything is replaced. A checkpoint of
+        sim 0.1.0 is read as one of today (:func:`upgraded`)."""
         state = upgraded(state)
         mine = {key: np.shape(value) for key, value in self.state_dict().items()}
         missing, unknown = sorted(set(mine) - set(state)), sorted(set(state) - set(mine))
@@ -58,7 +62,7 @@ class Checkpoints:
             raise ValueError(f"the checkpoint is not one of this scene's engine: arrays "
                              f"missing {missing}, unknown {unknown}")
         for key, value in state.items():
-            if key != "disks/nb" and np.shape(value) != mine[key]:
+            if key not in GROWING and np.shape(value) != mine[key]:
                 raise ValueError(f"the checkpoint's {key} has shape {np.shape(value)}, this "
                                  f"scene's engine {mine[key]}")
         for key, value in state.items():

@@ -1,9 +1,10 @@
 """The event loop's vocabulary, shared with the Python that drives it.
 
 Words: a *contact* is a disk touching a disk (a *collision*) or a wall (a *wall contact*); an
-*event* is what the loop applies: a contact or a shell exit. Stale events and first
-predictions are popped from the queue but are no events; a *system event*
-(:mod:`sim.engine.system`) is applied to the whole system and is not counted among them.
+*event* is what the loop applies: a contact, another event of a pair interaction
+(:mod:`sim.engine.pairs`) or a shell exit. Stale events and first predictions are popped from
+the queue but are no events; a *system event* (:mod:`sim.engine.system`) is applied to the
+whole system and is not counted among them.
 """
 
 # The kinds of event, by their code in Schedule.event_partner: a code ≥ 0 is a pair event
@@ -45,7 +46,7 @@ STATUS_LIST_FULL = -2
 STATUS_STALLED = -3
 
 # counters: int64[N_COUNTERS]
-EVENTS = 0  # applied events: contacts and shell exits
+EVENTS = 0  # applied events: contacts, other pair events and shell exits
 COLLISIONS = 1  # disk–disk contacts
 WALL_CONTACTS = 2
 SHELL_EXITS = 3

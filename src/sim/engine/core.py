@@ -20,7 +20,7 @@ from sim.effects.walls import closing_time
 from sim.engine import codes
 from sim.engine.box import folded
 from sim.engine.checkpoint import Checkpoints
-from sim.engine.groups import Box, Neighbours
+from sim.engine.groups import Box, Disks, Neighbours
 from sim.engine.inputs import (
     Boundary,
     box_size,
@@ -39,7 +39,7 @@ from sim.engine.kinematics import DISK_COLUMNS, RADIUS, VX, VY, X, Y
 from sim.engine.neighbours import build_all_neighbours, grow_lists, list_starts
 from sim.engine.observables import Observables
 from sim.engine.overlap import first_overlap
-from sim.engine.pairs import RULES
+from sim.engine.pairs import RULES, initial_reaches, initial_states, keeps
 from sim.engine.parameters import common_value
 from sim.engine.queue import BLOCK_EVENTS, build_queue, empty_queue
 from sim.engine.running import Running
@@ -81,7 +81,8 @@ class Engine(Running, Observables, Checkpoints):
     list_capacity : initial slots per neighbour list of an ordinary disk, whole from 1 to n
         (default from the expected number of neighbours); full lists grow on demand
     pair_interaction : a pair interaction (:mod:`sim.engine.pairs`): a value of a kind whose
-        rules are registered; default None, hard disks
+        rules are registered (its events, and optionally their names, its reach and a state
+        per pair); default None, hard disks
     system_event : a system event (:mod:`sim.engine.system`): a value of a kind whose
         handler is registered, applied to the whole system first at t = 0 and then at the
         times its handler returns; default None, none
@@ -163,7 +164,8 @@ class Engine(Running, Observables, Checkpoints):
                                        self.initial_energy, mass, self.gravity,
                                        self.wall_motion, self.wall_temperature)
         self.stall_watch = np.array([-math.inf, 0.0])
-        self._compiled_layout = None  # the list layout whose loop variant compile_once made
+        # the list layout and look-ahead whose loop variant compile_once made
+        self._compiled_layout = None
         #: wall-clock seconds this engine spent compiling (or loading) its event loop
         self.compile_seconds = 0.0
         self._build(position, velocity, shell, shell_lead, list_capacity, disk_effects,
@@ -175,7 +177,14 @@ class Engine(Running, Observables, Checkpoints):
         """Size shells and cells, allocate the state, link neighbours, schedule events;
         ``disk_effects``: the fields of :data:`OPTIONAL_PER_DISK`, ``first_event``:
         :func:`first_event_time`."""
-        n, radius, box = self.n, self.radius, self.box
+        n, radius, box, pair = self.n, self.radius, self.box, self.pair_interaction
+        table = np.zeros((n, DISK_COLUMNS))
+        table[:, X:Y + 1] = position
+        table[:, VX:VY + 1] = velocity
+        table[:, RADIUS] = radius
+        # how far each disk's pair events reach (sim.engine.pairs): its radius for hard disks
+        reaches = self._initial_reaches(table) if keeps(pair, "reach") else None
+        a = radius if reaches is None else reaches
         median = float(np.median(radius))
         big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
         if big.size > MAX_BIG:
@@ -189,19 +198,22 @@ class Engine(Running, Observables, Checkpoints):
         ratio = shell_ratio(phi_small) if shell is None else shell
         lead = shell_lead(phi_small) if lead is None else lead
         delta_small = 0.5 * (ratio - 1.0) * 2.0 * median
-        max_small = float(small_radius.max())
-        # the two largest radii: two disks whose shells overlap are less than R_i + R_j + 4 δ
-        # apart (shell centres within R_i + δ + R_j + δ, each disk within δ of its centre)
-        r_2, r_1 = (np.sort(radius)[-2:] if n > 1 else (0.0, radius[0]))
+        max_small = float(a[~is_big].max())
+        # the two largest reaches: two disks whose shells overlap are less than
+        # a_i + a_j + 4 δ apart (shell centres within a_i + δ + a_j + δ, each disk within δ of
+        # its centre)
+        r_2, r_1 = (np.sort(a)[-2:] if n > 1 else (0.0, a[0]))
         for axis in range(2):
             if self.periodic[axis]:
                 # predictions take the nearest image of a separation: that is the image in
-                # which the pair can touch only while R_1 + R_2 + 4 δ ≤ L/2
+                # which the pair can have an event only while a_1 + a_2 + 4 δ ≤ L/2
                 limit = 0.25 * (0.5 * box[axis] - r_1 - r_2)
                 if limit <= 0.0:
+                    what, a_sum = (("radii", "R_1 + R_2") if reaches is None
+                                   else ("pair events reaching", "a_1 + a_2"))
                     raise ValueError(f"periodic box side {box[axis]} is too small for disks of "
-                                     f"radii {r_1:g} and {r_2:g}: it must exceed "
-                                     f"2 (R_1 + R_2) = {2.0 * (r_1 + r_2):g}")
+                                     f"{what} {r_1:g} and {r_2:g}: it must exceed "
+                                     f"2 ({a_sum}) = {2.0 * (r_1 + r_2):g}")
                 delta_small = min(delta_small, limit)
         delta = np.full(n, delta_small)
         reach = max_small + delta_small
@@ -210,19 +222,20 @@ class Engine(Running, Observables, Checkpoints):
                                   lead])
         self.grid = np.array([cells[0], cells[1], int(self.periodic[0]), int(self.periodic[1])],
                              dtype=np.int64)
-        # list capacity: the expected number of overlapping shells, 4 φ (1 + δ/R)², plus three
-        # standard deviations of its (at most Poisson) fluctuations and a margin; the rare
-        # list that overflows grows on demand
-        expected = 4.0 * phi_small * (1.0 + delta_small / median) ** 2
+        # list capacity: the expected number of overlapping shells, 4 φ (a/R + δ/R)² (a the
+        # median reach, R the median radius), plus three standard deviations of its (at most
+        # Poisson) fluctuations and a margin; the rare list that overflows grows on demand
+        expected = 4.0 * phi_small * (float(np.median(a)) / median + delta_small / median) ** 2
         if list_capacity is None:
             list_capacity = int(4 * math.ceil((expected + 3.0 * math.sqrt(expected) + 4.0) / 4))
         cap = np.full(n, max(list_capacity, 1), dtype=np.int32)
         if big.size:
             density = max(phi_small, 0.6) / (np.pi * median**2)
-            reach_big = radius[big] + delta[big] + reach
+            reach_big = a[big] + delta[big] + reach
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
-        self.disks = self._initial_state(position, velocity, radius, delta, is_big, big, cap,
-                                         int(cells[0] * cells[1]), disk_effects)
+        self.disks = self._initial_state(table, delta, is_big, big, cap,
+                                         int(cells[0] * cells[1]), disk_effects, reaches)
+        del table  # copied into the state's buffer
         self.packing_fraction = phi
         d = self.disks
         # per-disk values every disk shares (None where they differ): the compiled code gets
@@ -238,6 +251,9 @@ class Engine(Running, Observables, Checkpoints):
             if full < 0:
                 break
             self._grow_lists(full)
+        if d.pair_state is not None:
+            initial_states(pair, self._disk_group(), self._neighbours(),
+                           Box(self.geometry, self.grid))
         # first predictions: every disk queued at t = 0 and predicted by the event loop itself
         # (with the argument types of every later call) in a call that may apply no event;
         # then the queue is sized for the predicted events. Until then its blocks are sized
@@ -258,18 +274,33 @@ class Engine(Running, Observables, Checkpoints):
         if n >= REORDER_MIN_DISKS:
             self.reorder()
 
-    def _initial_state(self, position, velocity, radius, delta, is_big, big, cap, n_cells,
-                       disk_effects):
+    def _initial_reaches(self, table):
+        """Every disk's reach a_i float64[n] by the rule of the pair interaction
+        (:func:`sim.engine.pairs.pair_reach`), at the construction: the rule sees the disk
+        group before any event, the shells not yet sized (``delta`` NaN). A reach below the
+        radius, or not finite, is refused."""
+        n = self.n
+        zeros = np.zeros(n, np.int32)
+        disks = Disks(table, np.nan, self.mass, self.species, zeros, zeros.copy(),
+                      np.zeros(n, np.int64), np.full(n, -np.inf), zeros.copy())
+        reach = np.empty(n)
+        initial_reaches(self.pair_interaction, disks, reach)
+        short = np.flatnonzero(~(reach >= table[:, RADIUS]) | ~np.isfinite(reach))
+        if short.size:
+            raise refused("Engine", "pair_interaction", self.pair_interaction,
+                          f"a kind whose reach is finite and at least the radius (disk "
+                          f"{short[0]}: reach {reach[short[0]]:g}, radius "
+                          f"{table[short[0], RADIUS]:g})")
+        return reach
+
+    def _initial_state(self, table, delta, is_big, big, cap, n_cells, disk_effects, reach):
         """The state arrays before any list is built or event predicted (:mod:`sim.engine.state`);
         its own function, so that the arrays it makes are freed once they are copied into
-        the state's buffer."""
+        the state's buffer. ``reach``: every disk's reach, None for the radii."""
         n = self.n
+        pair = self.pair_interaction
         minus_one = np.full(n, -1, dtype=np.int32)
         heap, links, list_head, calendar, block_rate = empty_queue(n)
-        table = np.zeros((n, DISK_COLUMNS))
-        table[:, X:Y + 1] = position
-        table[:, VX:VY + 1] = velocity
-        table[:, RADIUS] = radius
         return DiskArrays(
             table=table, delta=delta, mass=self.mass.copy(), species=self.species.copy(),
             is_big=is_big, stamp=np.zeros(n, np.int32), counted=np.zeros(n, np.int32),
@@ -284,6 +315,10 @@ class Engine(Running, Observables, Checkpoints):
             big=big.astype(np.int32),
             cell_head=np.full(n_cells, -1, dtype=np.int32),
             system_time=np.array([np.inf if self.system_event is None else 0.0]),
+            pair_event=np.zeros(n, np.int32) if keeps(pair, "apply") else None,
+            reach=reach,
+            pair_state=(np.zeros(int(cap.sum()), np.int32) if keeps(pair, "initial_state")
+                        else None),
             **disk_effects)
 
     def _effects(self):
@@ -311,7 +346,7 @@ class Engine(Running, Observables, Checkpoints):
         (:class:`sim.engine.groups.Neighbours`, the lists' layout of :meth:`_list_layout`)."""
         d = self.disks
         return Neighbours(*self._list_layout(), d.nb_count, d.nb, d.cell_head, d.cell_next,
-                          d.cell_prev, d.cell_of, d.big)
+                          d.cell_prev, d.cell_of, d.big, d.reach, d.pair_state)
 
     def _grow_lists(self, full):
         """Enlarge the lists after ``full`` overflowed. Lists of one common capacity all grow
@@ -323,7 +358,8 @@ class Engine(Running, Observables, Checkpoints):
             new_cap[np.union1d([full], np.flatnonzero(d.nb_count >= d.nb_cap))] *= 2
         else:
             new_cap = d.nb_cap + np.int32(LIST_GROWTH)
-        d.nb_start, d.nb = grow_lists(d.nb_start, d.nb_count, d.nb, new_cap)
+        d.nb_start, d.nb, d.pair_state = grow_lists(d.nb_start, d.nb_count, d.nb, new_cap,
+                                                    d.pair_state)
         d.nb_cap = new_cap
         d.pack()
         self._common_capacity = common_value(d.nb_cap)

@@ -2,8 +2,9 @@
 
 :func:`sim.engine.loop.run_events` takes seven tuples: what it reads and writes of the disks,
 the schedule of their events, the neighbour lists and cells, the box, the effects
-(:class:`sim.effects.Effects`), the running tallies and the limits of one call; and the
-values of the parts a scene may replace (:class:`Parts`) one by one. numba
+(:class:`sim.effects.Effects`), the running tallies and the limits of one call; and, one by
+one, the values of the parts a scene may replace (:class:`Parts`) and whether it looks
+ahead (True, or None: a variant of the loop without the look-ahead's code). numba
 passes a tuple's fields as separate arguments, so grouping costs nothing; fields are read by
 name, and a field that is a number where it could be an array (a mass every disk shares, one
 list capacity for all) compiles a variant that never loads the array
@@ -40,6 +41,7 @@ class Schedule(NamedTuple):
     calendar: np.ndarray
     block_rate: np.ndarray
     system_time: np.ndarray  # float64[1] the next system event, relative clock
+    pair_event: object  # int32[n] the pair event's name (sim.engine.pairs), or None
 
 
 class Neighbours(NamedTuple):
@@ -53,6 +55,8 @@ class Neighbours(NamedTuple):
     cell_prev: np.ndarray
     cell_of: np.ndarray
     big: np.ndarray  # int32[n_big] disks kept out of the cells
+    reach: object  # float64[n] each disk's reach a_i, or None: the radii
+    pair_state: object  # int32[Σ capacity] each entry's pair state, or None: no state
 
 
 class Box(NamedTuple):
@@ -89,4 +93,3 @@ class Limits(NamedTuple):
     dissipation_limit: float
     stall_dt: float
     rebase_every: int
-    lookahead: bool

@@ -1,10 +1,11 @@
 """The compiled event loop: pop the earliest event, apply it, predict anew.
 
 Each disk owns one scheduled event, the earliest of (Smallenburg, Eur. Phys. J. E 45, 22 (2022)):
-  * a contact with a disk of its neighbour list (``partner ≥ 0``), valid while the partner's
-    staleness stamp (:mod:`sim.engine.stamps`) still equals the value recorded at prediction,
-    and scheduled only when it comes no later than the partner's own next event
-    (:func:`predict`);
+  * a pair event with a disk of its neighbour list (``partner ≥ 0``): a contact, or another
+    event of the scene's pair interaction (:mod:`sim.engine.pairs`, whose name for it is kept
+    in ``Schedule.pair_event``), valid while the partner's staleness stamp
+    (:mod:`sim.engine.stamps`) still equals the value recorded at prediction, and scheduled
+    only when it comes no later than the partner's own next event (:func:`predict`);
   * a contact with a wall (``partner = WALL_X_LOW … WALL_Y_HIGH``);
   * its exit from its neighbour shell (``partner = SHELL_EXIT``), which rebuilds its list;
   * at construction, its first prediction (``partner = UNPREDICTED``, at the current time):
@@ -43,7 +44,7 @@ from sim.effects.rotation import rough_wall_contact
 from sim.effects.tc import tc_restitution
 from sim.effects.thermal_walls import contact_key
 from sim.effects.walls import hit_wall, predict_wall_contact
-from sim.engine.box import PERIODIC, fold, separation
+from sim.engine.box import PERIODIC, fold, image_velocity, separation
 from sim.engine.codes import (
     COLLISIONS,
     DISSIPATED_DISKS,
@@ -84,15 +85,16 @@ from sim.engine.kinematics import (
     X,
     Y,
 )
-from sim.engine.lookahead import prefetch_upcoming
+from sim.engine.lookahead import prefetch_next, prefetch_upcoming
 from sim.engine.neighbours import list_start, rebuild_neighbours
 from sim.engine.pairs import (
     apply_pair_event,
     collide,
     own_apply,
     pair_event_time,
+    pair_reach,
 )
-from sim.engine.parameters import per_disk
+from sim.engine.parameters import optional_entry, per_disk, set_optional_entry
 from sim.engine.queue import (
     build_queue,
     earliest,
@@ -107,8 +109,9 @@ from sim.engine.system import apply_system_event
 def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
     """The earliest event of disk i, which must be at time t already (``t_origin``: the
     absolute time of the clock's zero, which moving walls need): its time, its partner (a
-    disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``) and the partner's staleness stamp when
-    the partner is a disk (else 0), for :func:`set_event`.
+    disk, a wall code, ``SHELL_EXIT`` or ``NO_EVENT``), the partner's staleness stamp when
+    the partner is a disk (else 0) and the pair interaction's name of the event (0 but for
+    a pair event), for :func:`set_event`.
 
     A contact with j at time t_ij is left out when j's own next event comes first
     (``event_time[j] < t_ij``): j is predicted again at that event, whatever it is, and then
@@ -142,34 +145,40 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
                 partner = WALL_X_LOW - 2 * axis - side if side >= 0 else SHELL_EXIT
     nb = neighbours.nb
     event_time = schedule.event_time
+    event = 0
     start = list_start(neighbours.nb_start, i)
     for k in range(start, start + neighbours.nb_count[i]):
         j = nb[k]
         dt = t - table[j, T_OWN]
         vx_j = velocity_of(j, 0, dt, table, gravity)
         vy_j = velocity_of(j, 1, dt, table, gravity)
-        rx, ry = separation(box, x - table[j, X] - flown(j, 0, dt, table, gravity),
-                            y - table[j, Y] - flown(j, 1, dt, table, gravity))
-        vx_ij = vx - vx_j
-        vy_ij = vy - vy_j
-        tau_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij, r_i + table[j, RADIUS],
-                                 tau, disks)
+        dx = x - table[j, X] - flown(j, 0, dt, table, gravity)
+        dy = y - table[j, Y] - flown(j, 1, dt, table, gravity)
+        rx, ry = separation(box, dx, dy)
+        ux, uy = image_velocity(box, dy, ry)
+        vx_ij = vx - vx_j - ux
+        vy_ij = vy - vy_j - uy
+        tau_ij, event_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij,
+                                           r_i + table[j, RADIUS], tau,
+                                           optional_entry(neighbours.pair_state, k, 0), disks)
         if tau_ij < tau and t + tau_ij <= event_time[j]:
             tau = tau_ij
             partner = j
+            event = event_ij
     if tau == INF:
         partner = NO_EVENT
-    return t + tau, partner, disks.stamp[partner] if partner >= 0 else np.int32(0)
+    return t + tau, partner, disks.stamp[partner] if partner >= 0 else np.int32(0), event
 
 
 @njit(cache=True, inline="always")
-def set_event(i, when, partner, partner_stamp, schedule):
+def set_event(i, when, partner, partner_stamp, event, schedule):
     """Record the event :func:`predict` found for disk i; filing it in the queue
     (:func:`sim.engine.queue.reschedule`) comes after."""
     schedule.event_time[i] = when
     schedule.event_partner[i] = partner
     if partner >= 0:
         schedule.event_stamp[i] = partner_stamp
+        set_optional_entry(schedule.pair_event, i, event)
 
 
 @njit(cache=True, inline="always")
@@ -225,16 +234,16 @@ def predict_and_file(i, j, t, disks, schedule, neighbours, box, effects, pair, t
     recorded only once i is filed."""
     s = schedule
     moved_disks = 1 if j < 0 else 2
-    when, whom, whose_stamp = INF, NO_EVENT, np.int32(0)
+    when, whom, whose_stamp, event = INF, NO_EVENT, np.int32(0), 0
     for k in range(moved_disks):
-        when, whom, whose_stamp = predict(i if k == 0 else j, t, disks, schedule, neighbours,
-                                          box, effects, pair, t_origin)
+        when, whom, whose_stamp, event = predict(i if k == 0 else j, t, disks, schedule,
+                                                 neighbours, box, effects, pair, t_origin)
         prefetch_bucket(s.list_head, s.calendar, s.block_rate, when)
         if k == 0:
-            set_event(i, when, whom, whose_stamp, schedule)
+            set_event(i, when, whom, whose_stamp, event, schedule)
     for k in range(moved_disks):
         if k == 1:  # the prediction of j, the last one made
-            set_event(j, when, whom, whose_stamp, schedule)
+            set_event(j, when, whom, whose_stamp, event, schedule)
         reschedule(s.heap, s.links, s.list_head, s.calendar, s.block_rate, s.event_time,
                    i if k == 0 else j)
 
@@ -273,20 +282,22 @@ def stop_status(limits, partner, t, t_stop, t_previous, stalled, stall_limit, ev
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def run_events(disks, schedule, neighbours, box, effects, pair, system, tallies, limits):
+def run_events(disks, schedule, neighbours, box, effects, pair, system, lookahead, tallies,
+               limits):
     """Process events in time order until :func:`stop_status` ends the loop; see the module
     docstring. Returns (status, the disk it concerns or −1).
 
     ``pair`` and ``system`` are the fields of :class:`sim.engine.groups.Parts`, passed one by
     one: numba prunes a branch ``if system is not None`` only for an argument of the function
     it compiles, so that a scene without a system event compiles none of its code (0.7 s of
-    the first compilation, against the group).
+    the first compilation, against the group). ``lookahead``: True to prefetch several events
+    ahead, for states larger than the caches
+    (:func:`sim.engine.lookahead.prefetch_upcoming`), else None, and the loop compiles none of
+    it.
 
     ``tallies.stall_watch`` carries the time of the last event popped (relative clock) and
     the length of its stall run from one call to the next; counters and accumulators live in
     local variables (registers) during the loop and are written back when it stops.
-    ``limits.lookahead``: prefetch several events ahead, for states larger than the caches
-    (:func:`sim.engine.lookahead.prefetch_upcoming`).
     """
     counters, accumulators = tallies.counters, tallies.accumulators
     events = counters[EVENTS]
@@ -323,8 +334,11 @@ def run_events(disks, schedule, neighbours, box, effects, pair, system, tallies,
             culprit = i if status == STATUS_STALLED and partner != SYSTEM else -1
             break
         t_previous = t
-        walker, walker_block = prefetch_upcoming(partner, limits.lookahead, walker, walker_block,
-                                                 disks, schedule, neighbours, box)
+        if lookahead is None:
+            prefetch_next(partner, 3, disks, schedule, neighbours)
+        else:
+            walker, walker_block = prefetch_upcoming(partner, walker, walker_block, disks,
+                                                     schedule, neighbours, box)
         t_origin = accumulators[T_ORIGIN]
         fly(i, t, disks.table, box, effects.gravity, effects.images)
         j = NO_EVENT  # the second disk to re-predict, when it is a collision
@@ -333,20 +347,21 @@ def run_events(disks, schedule, neighbours, box, effects, pair, system, tallies,
         elif partner >= 0:
             j = partner
             fly(j, t, disks.table, box, effects.gravity, effects.images)
-            collisions += 1
             events += 1
             if pair is not None and own_apply(pair):
-                lost, virial, log_full, culprit = apply_pair_event(
-                    pair, i, j, t, t_origin, disks, box, effects, tallies,
-                    collisions + wall_contacts)
+                lost, virial, log_full, culprit, contact = apply_pair_event(
+                    pair, optional_entry(s.pair_event, i, 0), i, j, t, t_origin, disks, neighbours,
+                    box, effects, tallies, collisions + wall_contacts + 1)
+                collisions += 1 if contact else 0
             else:
+                collisions += 1
                 lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
                                                           tallies, collisions + wall_contacts)
             dissipated_disks += lost
             virial_sum += virial
         elif partner == SHELL_EXIT:
-            culprit = rebuild_neighbours(i, disks.table, disks.delta, neighbours, box,
-                                         limits.lookahead)
+            culprit = rebuild_neighbours(i, pair_reach(pair, i, disks), disks.table,
+                                         disks.delta, neighbours, box, lookahead is not None)
             if culprit >= 0:
                 status = STATUS_LIST_FULL
                 break

@@ -2,10 +2,13 @@
 
 Design after Smallenburg, Eur. Phys. J. E 45, 22 (2022): disk i owns a shell, the circle of
 radius ``delta[i]`` around its centre c_i (set when the list was last built). Until its
-shell-exit event, disk i stays inside the shell, so i and j can only touch while
-``|c_i - c_j| < R_i + R_j + δ_i + δ_j``. The neighbour lists hold exactly those pairs and are
+shell-exit event, disk i stays inside the shell, so i and j can only have a pair event while
+``|c_i - c_j| < a_i + a_j + δ_i + δ_j``, a_i the reach of disk i: its radius R_i for hard
+disks, else what the pair interaction says (:func:`sim.engine.pairs.pair_reach`), frozen at
+each rebuild of i's list (``reach[i]``). The neighbour lists hold exactly those pairs and are
 kept symmetric: when i rebuilds, it leaves the lists of the neighbours it loses and joins the
-lists of the ones it gains.
+lists of the ones it gains. A pair interaction that keeps a state per pair has it beside the
+pair's two entries (``pair_state``, moved with them), 0 for a pair that joins the lists.
 
 A new shell is centred a little ahead of its disk along its velocity (:func:`shell_centre`),
 so that in a dilute gas a disk flies further before it leaves. The grid files disks by shell
@@ -25,7 +28,8 @@ Arrays (n disks), of which the compiled functions take ``neighbours`` and ``box`
   (:func:`list_start`, :func:`sim.engine.parameters.per_disk`): a list's start is then computed, not
   loaded, and the neighbours of a disk are one load closer;
   cell_head int32[ncx*ncy], cell_next int32[n], cell_prev int32[n], cell_of int32[n] (-1 big);
-  big int32[n_big];
+  big int32[n_big]; reach float64[n], or None for the radii (the table's column RADIUS);
+  pair_state int32[sum(nb_cap)] beside ``nb``, or None for a pair interaction without state;
   geometry float64[6] and grid int64[4] — the box and its cells (:mod:`sim.engine.box`).
 """
 
@@ -46,7 +50,7 @@ from sim.engine.kinematics import (
     X,
     Y,
 )
-from sim.engine.parameters import per_disk
+from sim.engine.parameters import optional_entry, per_disk, set_optional_entry
 from sim.engine.prefetch import prefetch
 
 
@@ -108,32 +112,40 @@ def _cell_remove(i, neighbours):
 
 
 @njit(cache=True, inline="always")
-def _remove_from_list(owner, disk, nb_start, nb_count, nb):
+def _remove_from_list(owner, disk, neighbours):
     """Remove ``disk`` (which must be listed) from the list of ``owner``: the last entry
-    takes its place. The whole short list is scanned with a select instead of stopping at
-    the match, whose position the branch predictor cannot guess."""
-    start = list_start(nb_start, owner)
+    (and its pair's state) takes its place. The whole short list is scanned with a select
+    instead of stopping at the match, whose position the branch predictor cannot guess."""
+    nb_count, nb, pair_state = neighbours.nb_count, neighbours.nb, neighbours.pair_state
+    start = list_start(neighbours.nb_start, owner)
     last = start + nb_count[owner] - 1
     found = last
     for k in range(start, last):
         found = k if nb[k] == disk else found
     nb[found] = nb[last]
+    set_optional_entry(pair_state, found, optional_entry(pair_state, last, 0))
     nb_count[owner] -= 1
 
 
 @njit(cache=True, inline="always")
-def _shells_overlap(cx, cy, i, j, table, delta, box):
-    """Whether the shell of j overlaps a shell of disk i centred at (cx, cy) (NaN: never).
+def _shells_overlap(box, dx, dy, reach_i, reach_j):
+    """Whether two shells whose centres are (dx, dy) apart (NaN: never), one reaching
+    ``reach_i`` = a_i + δ_i from its centre and the other ``reach_j`` = a_j + δ_j, overlap.
 
-    The reach is summed per disk first, (R_i + δ_i) + (R_j + δ_j), and the separation only
-    changes sign with the order, so the test gives the same answer for (i, j) and (j, i) to the
-    last bit: the lists hold exactly the overlapping pairs, which the rebuild relies on.
+    The reaches are summed per disk first, and the separation only changes sign with the
+    order, so the test gives the same answer for (i, j) and (j, i) to the last bit: the lists
+    hold exactly the overlapping pairs, which the rebuild relies on.
     """
-    dx, dy = separation(box, cx - table[j, CX], cy - table[j, CY])
-    reach_i = table[i, RADIUS] + per_disk(delta, i)
-    reach_j = table[j, RADIUS] + per_disk(delta, j)
-    reach = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
-    return dx * dx + dy * dy < reach * reach
+    dx, dy = separation(box, dx, dy)
+    reach_ij = (reach_i + reach_j) * (1.0 + SHELL_SLACK)
+    return dx * dx + dy * dy < reach_ij * reach_ij
+
+
+@njit(cache=True, inline="always")
+def shell_reach(i, table, delta, reach):
+    """How far the shell of disk i reaches from its centre: a_i + δ_i, a_i the reach frozen at
+    its last rebuild (``reach[i]``, the radius when ``reach`` is None)."""
+    return optional_entry(reach, i, table[i, RADIUS]) + per_disk(delta, i)
 
 
 @njit(cache=True, inline="always")
@@ -159,16 +171,19 @@ def _fold(a, nc):
 
 
 @njit(cache=True, inline="always")
-def _consider(j, found, search, table, delta, nb, free, room, box):
+def _consider(j, found, search, table, delta, neighbours, free, room, box):
     """One candidate j for the ``search`` of :func:`_find_new_neighbours`: written into the
     next free slot, counted when it is new. Returns the new count, or -1 when a new neighbour
     does not fit the list."""
-    i, cx, cy, cx_old, cy_old, first_candidate = search
-    listed = _shells_overlap(cx_old, cy_old, i, j, table, delta, box)
+    i, cx, cy, reach_i, cx_old, cy_old, reach_old, first_candidate = search
+    cx_j = table[j, CX]
+    cy_j = table[j, CY]
+    reach_j = shell_reach(j, table, delta, neighbours.reach)
+    listed = _shells_overlap(box, cx_old - cx_j, cy_old - cy_j, reach_old, reach_j)
     new = ((j != i) & (j >= first_candidate) & (not listed)
-           & _shells_overlap(cx, cy, i, j, table, delta, box))
+           & _shells_overlap(box, cx - cx_j, cy - cy_j, reach_i, reach_j))
     if found < room:
-        nb[free + found] = j
+        neighbours.nb[free + found] = j
     elif new:
         return -1
     return found + new
@@ -205,9 +220,10 @@ def _prefetch_candidates(x_lo, x_hi, y_lo, y_hi, table, cell_head, cell_next, gr
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _find_new_neighbours(search, table, delta, neighbours, box, hint_candidates):
     """Append after the list of disk i (its count unchanged) every disk j ≥ first_candidate,
-    j ≠ i, whose shell overlaps the shell of i centred at (cx, cy) but not the one centred at
-    (cx_old, cy_old); NaN for the old centre drops that condition. ``search`` is
-    ``(i, cx, cy, cx_old, cy_old, first_candidate)``.
+    j ≠ i, whose shell overlaps the shell of i centred at (cx, cy) and reaching a_i + δ_i =
+    ``reach_i`` but not the one centred at (cx_old, cy_old) and reaching ``reach_old``; NaN
+    for the old centre drops that condition. ``search`` is
+    ``(i, cx, cy, reach_i, cx_old, cy_old, reach_old, first_candidate)``.
 
     Small disks scan the 3×3 cells around (cx, cy) and the big disks; a big disk scans the cells
     within its reach. Returns the number of disks found, or -1 when they do not fit the list.
@@ -221,10 +237,10 @@ def _find_new_neighbours(search, table, delta, neighbours, box, hint_candidates)
     ``hint_candidates`` as a bool from Python, never a literal, so that they share one
     specialisation): 3.5 s less of the first compilation, and 2.8 s more for a literal.
     """
-    i, cx, cy, _, _, _ = search
+    i, cx, cy, reach_i, _, _, _, _ = search
     geometry, grid = box.geometry, box.grid
-    nb_count, nb, cell_head, cell_next = (neighbours.nb_count, neighbours.nb,
-                                          neighbours.cell_head, neighbours.cell_next)
+    nb_count, cell_head, cell_next = (neighbours.nb_count, neighbours.cell_head,
+                                      neighbours.cell_next)
     ncx = grid[CELLS]
     ncy = grid[CELLS + 1]
     c = cell_index(cx, cy, geometry, grid)
@@ -232,7 +248,7 @@ def _find_new_neighbours(search, table, delta, neighbours, box, hint_candidates)
         kx = 1
         ky = 1
     else:
-        reach = table[i, RADIUS] + per_disk(delta, i) + geometry[REACH]
+        reach = reach_i + geometry[REACH]
         kx = int(math.ceil(reach / geometry[CELL_SIDE]))
         ky = int(math.ceil(reach / geometry[CELL_SIDE + 1]))
     x_lo, x_hi = axis_span(c % ncx, kx, ncx, grid[PERIODIC] != 0)
@@ -247,13 +263,13 @@ def _find_new_neighbours(search, table, delta, neighbours, box, hint_candidates)
         for ax in range(x_lo, x_hi):
             j = cell_head[row + _fold(ax, ncx)]
             while j >= 0:
-                found = _consider(j, found, search, table, delta, nb, free, room, box)
+                found = _consider(j, found, search, table, delta, neighbours, free, room, box)
                 if found < 0:
                     return -1
                 j = cell_next[j]
     big = neighbours.big
     for b in range(big.shape[0]):
-        found = _consider(big[b], found, search, table, delta, nb, free, room, box)
+        found = _consider(big[b], found, search, table, delta, neighbours, free, room, box)
         if found < 0:
             return -1
     return found
@@ -315,8 +331,9 @@ def _full_list(first, found, neighbours):
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def rebuild_neighbours(i, table, delta, neighbours, box, hint_candidates):
-    """New shell for disk i centred on its current position, and its new list.
+def rebuild_neighbours(i, a_i, table, delta, neighbours, box, hint_candidates):
+    """New shell for disk i centred on its current position, reaching a_i + δ_i (a_i: its
+    reach from now on, :func:`sim.engine.pairs.pair_reach`), and its new list.
 
     Only the differences are written. The lists hold exactly the pairs of overlapping shells,
     so a disk near the new centre is new to the list when its shell overlaps the new shell but
@@ -329,12 +346,15 @@ def rebuild_neighbours(i, table, delta, neighbours, box, hint_candidates):
     ``hint_candidates``: see :func:`_find_new_neighbours`.
     """
     nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
-    cell_of = neighbours.cell_of
+    cell_of, pair_state = neighbours.cell_of, neighbours.pair_state
     cx, cy = shell_centre(i, table, delta, box)
     start = list_start(nb_start, i)
     old = nb_count[i]
-    found = _find_new_neighbours((np.int64(i), cx, cy, table[i, CX], table[i, CY], np.int64(0)),
-                                 table, delta, neighbours, box, hint_candidates)
+    reach_i = a_i + per_disk(delta, i)
+    reach_old = shell_reach(i, table, delta, neighbours.reach)
+    found = _find_new_neighbours(
+        (np.int64(i), cx, cy, reach_i, table[i, CX], table[i, CY], reach_old, np.int64(0)),
+        table, delta, neighbours, box, hint_candidates)
     if found < 0:
         return i
     full = _full_list(start + old, found, neighbours)
@@ -343,18 +363,24 @@ def rebuild_neighbours(i, table, delta, neighbours, box, hint_candidates):
     kept = start
     for k in range(start, start + old):
         j = nb[k]
-        if _shells_overlap(cx, cy, i, j, table, delta, box):
+        if _shells_overlap(box, cx - table[j, CX], cy - table[j, CY], reach_i,
+                           shell_reach(j, table, delta, neighbours.reach)):
             nb[kept] = j
+            set_optional_entry(pair_state, kept, optional_entry(pair_state, k, 0))
             kept += 1
         else:
-            _remove_from_list(j, i, nb_start, nb_count, nb)
+            _remove_from_list(j, i, neighbours)
     for k in range(start + old, start + old + found):
         j = nb[k]
         nb[kept] = j
+        set_optional_entry(pair_state, kept, 0)
         kept += 1
-        nb[list_start(nb_start, j) + nb_count[j]] = i
+        m = list_start(nb_start, j) + nb_count[j]
+        nb[m] = i
+        set_optional_entry(pair_state, m, 0)
         nb_count[j] += 1
     nb_count[i] = kept - start
+    set_optional_entry(neighbours.reach, i, a_i)
     table[i, CX] = cx
     table[i, CY] = cy
     if cell_of[i] >= 0:
@@ -367,9 +393,10 @@ def rebuild_neighbours(i, table, delta, neighbours, box, hint_candidates):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def build_all_neighbours(table, delta, is_big, neighbours, box, hint_candidates):
-    """Centre every shell on its disk, file the small disks in cells and link all pairs.
-    Returns the disk whose list overflowed, or -1. ``hint_candidates``: see
-    :func:`_find_new_neighbours`."""
+    """Centre every shell on its disk, file the small disks in cells and link all pairs,
+    each disk reaching a_i + δ_i (a_i from ``neighbours.reach``, else its radius). Returns the
+    disk whose list overflowed, or -1. ``hint_candidates``: see :func:`_find_new_neighbours`.
+    Pair states are left as they are: the engine sets them (:mod:`sim.engine.pairs`)."""
     nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
     n = table.shape[0]
     neighbours.cell_head[:] = -1
@@ -384,9 +411,10 @@ def build_all_neighbours(table, delta, is_big, neighbours, box, hint_candidates)
             _cell_insert(i, c, neighbours)
     for i in range(n):
         first = list_start(nb_start, i) + nb_count[i]
+        reach_i = shell_reach(i, table, delta, neighbours.reach)
         found = _find_new_neighbours(
-            (np.int64(i), table[i, CX], table[i, CY], np.nan, np.nan, np.int64(i + 1)),
-            table, delta, neighbours, box, hint_candidates)
+            (np.int64(i), table[i, CX], table[i, CY], reach_i, np.nan, np.nan, np.nan,
+             np.int64(i + 1)), table, delta, neighbours, box, hint_candidates)
         if found < 0:
             return i
         full = _full_list(first, found, neighbours)
@@ -401,14 +429,17 @@ def build_all_neighbours(table, delta, is_big, neighbours, box, hint_candidates)
 
 
 @njit(cache=True)
-def copy_lists(order, new_id, nb_start, nb_count, nb, new_start, new_nb):
+def copy_lists(order, new_id, nb_start, nb_count, nb, new_start, new_nb, pair_state, new_state):
     """Write into ``new_nb`` at ``new_start[k]`` the list of disk ``order[k]``, each entry j
-    as ``new_id[j]``: lists moved to a new layout (identity ``order`` and ``new_id``) or
-    renumbered, without temporary arrays."""
+    as ``new_id[j]``, and its pairs' states into ``new_state`` (both None when there are
+    none): lists moved to a new layout (identity ``order`` and ``new_id``) or renumbered,
+    without temporary arrays."""
     for k in range(order.shape[0]):
         i = order[k]
         for m in range(nb_count[i]):
             new_nb[new_start[k] + m] = new_id[nb[nb_start[i] + m]]
+            set_optional_entry(new_state, new_start[k] + m,
+                               optional_entry(pair_state, nb_start[i] + m, 0))
 
 
 def list_starts(capacity):
@@ -423,12 +454,16 @@ def list_starts(capacity):
     return starts
 
 
-def grow_lists(nb_start, nb_count, nb, new_cap):
-    """Return the list starts and lists (``nb_start``, ``nb``) laid out anew for the
-    capacities ``new_cap`` int32[n], each at least the old one; contents and counts are kept.
-    A rare step, done between compiled calls."""
+def grow_lists(nb_start, nb_count, nb, new_cap, pair_state):
+    """Return the list starts, lists and pairs' states (``nb_start``, ``nb``, ``pair_state``,
+    None when there is none) laid out anew for the capacities ``new_cap`` int32[n], each at
+    least the old one; contents and counts are kept. A rare step, done between compiled
+    calls."""
     new_start = list_starts(new_cap)
-    new_nb = np.full(int(new_cap.sum(dtype=np.int64)), -1, dtype=np.int32)
+    slots = int(new_cap.sum(dtype=np.int64))
+    new_nb = np.full(slots, -1, dtype=np.int32)
+    new_state = None if pair_state is None else np.zeros(slots, dtype=np.int32)
     identity = np.arange(nb_start.size)
-    copy_lists(identity, identity, nb_start, nb_count, nb, new_start, new_nb)
-    return new_start, new_nb
+    copy_lists(identity, identity, nb_start, nb_count, nb, new_start, new_nb, pair_state,
+               new_state)
+    return new_start, new_nb, new_state

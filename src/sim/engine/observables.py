@@ -40,8 +40,8 @@ class Observables:
 
     @property
     def events(self):
-        """Events the engine applied so far: contacts and neighbour-shell exits (the words
-        of :mod:`sim.engine.codes`)."""
+        """Events the engine applied so far: contacts, other events of a pair interaction
+        and neighbour-shell exits (the words of :mod:`sim.engine.codes`)."""
         return int(self.counters[codes.EVENTS])
 
     @property

@@ -11,22 +11,41 @@ A kind of pair interaction is a NamedTuple class (its value: the constants of th
 compiled rules registered for it by :func:`rules`; numba picks them by the value's type while
 it compiles the loop, so the registry is fixed at import. The rules are
 
-``event_time(value, i, j, rx, ry, vx, vy, sigma, tau, disks)``
-    the time until disks i and j (separation r = r_i − r_j through the boundary, relative
-    velocity v = v_i − v_j, hard-core distance σ = R_i + R_j, the loop's disk group) next have
-    an event, ``math.inf`` for none; it may return any time ≥ τ, the earliest event found so
-    far, when the pair has none before τ; never a negative time;
+``event_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks)``
+    the next event of disks i and j (separation r = r_i − r_j through the boundary, relative
+    velocity v = v_i − v_j, hard-core distance σ = R_i + R_j, the pair's ``state``, the loop's
+    disk group) as (time until it, event): ``event`` a whole number ≥ 0 that names the kind's
+    own event (a core contact, a step crossed …), kept with the prediction and given to
+    ``apply``; a time ``math.inf`` for none. It may return any time ≥ τ, the earliest event
+    found so far, when the pair has none before τ; never a negative time.
 ``apply`` (optional; default :func:`collide`, the hard-core contact)
-    ``apply(value, i, j, t, t_origin, disks, box, effects, tallies, contact)`` with both disks
-    flown to t, as the run's ``contact``-th contact: change their motion and bump both
-    staleness stamps (:mod:`sim.engine.stamps`); returns (energy dissipated, r·Δp_i, event
-    log full, the disk found collapsing or −1), as :func:`collide`.
+    ``apply(value, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
+    contact)`` with both disks flown to t, where ``contact`` is the run's count of contacts
+    should the event be one: change their motion and their pair's state
+    (:func:`set_pair_state`); bump both staleness stamps (:mod:`sim.engine.stamps`) for a
+    contact, or :func:`sim.engine.stamps.invalidate` each disk whose motion changed by an
+    event that is no contact. Returns (energy dissipated, r·Δp_i, event log full, the disk
+    found collapsing or −1, whether the event was a contact); a contact is counted as a
+    collision, any pair event as an event.
+``reach`` (optional; default the radius)
+    ``reach(value, i, disks)``: a length a_i such that disks i and j have no event while they
+    are more than a_i + a_j apart. The neighbour shells reach it
+    (:mod:`sim.engine.neighbours`), frozen per disk at each rebuild of its list.
+``initial_state`` (optional; a kind that has it keeps a state per pair)
+    ``initial_state(value, i, j, rx, ry, sigma, disks)``: the state (an int32) of a pair at
+    the engine's construction, from its separation. From then on the events alone change it
+    (:func:`set_pair_state`); a pair that joins the neighbour lists later is farther apart
+    than its reach and starts at state 0. The state is kept beside the pair's entries of the
+    lists (``Neighbours.pair_state``), through rebuilds, renumbering and checkpoints.
 
-Every pair event counts as a collision. Neighbour shells reach the hard core σ: a rule may not
-give an event beyond it.
+A kind without its own ``apply`` keeps no event of its own: its ``event`` is taken as a
+contact. A scene pays for what its kind has and nothing else: the event names, the reach
+and the state arrays are None for a kind without them (and for hard disks), and numba
+compiles them away.
 """
 
 import math
+from typing import NamedTuple
 
 from numba import njit, types
 from numba.core.errors import TypingError
@@ -39,16 +58,26 @@ from sim.effects.rotation import rough_collision
 from sim.effects.tc import tc_restitution
 from sim.engine.box import separation
 from sim.engine.contact import collide_disks
-from sim.engine.kinematics import INF, X, Y, may_touch_before, pair_contact_time
+from sim.engine.kinematics import INF, RADIUS, X, Y, may_touch_before, pair_contact_time
+from sim.engine.neighbours import list_start
 from sim.engine.parameters import per_disk
 
-#: the rules of each kind of pair interaction: NamedTuple class → (event_time, apply or None)
+
+class Rules(NamedTuple):
+    """The compiled rules of a kind of pair interaction (see the module docstring)."""
+    event_time: object
+    apply: object = None
+    reach: object = None
+    initial_state: object = None
+
+
+#: the rules of each kind of pair interaction: NamedTuple class → :class:`Rules`
 RULES = {}
 
 
-def rules(kind, event_time, apply=None):
+def rules(kind, event_time, apply=None, *, reach=None, initial_state=None):
     """Register the compiled rules of the pair interaction ``kind`` (a NamedTuple class)."""
-    RULES[kind] = (event_time, apply)
+    RULES[kind] = Rules(event_time, apply, reach, initial_state)
 
 
 def _rules_of(value):
@@ -65,13 +94,19 @@ def own_apply(pair):
     :func:`collide` directly when it is False or ``pair`` None: the contact is then compiled
     as it was before the seam existed (through an overload it took 3 s more of the first
     compilation)."""
-    return RULES[type(pair)][1] is not None
+    return keeps(pair, "apply")
 
 
 @overload(own_apply, inline="always")
 def _own_apply(pair):
-    own = _rules_of(pair)[1] is not None
+    own = _rules_of(pair).apply is not None
     return lambda pair: own
+
+
+def keeps(pair, rule):
+    """Whether the kind of ``pair`` (None: hard disks) has the optional rule ``rule``
+    (``"apply"``, ``"reach"``, ``"initial_state"``): the engine then allocates its arrays."""
+    return pair is not None and getattr(RULES[type(pair)], rule) is not None
 
 
 @njit(cache=True, inline="always")
@@ -84,39 +119,119 @@ def hard_core_time(rx, ry, vx, vy, sigma, tau):
     return INF
 
 
-def pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, disks):
-    """The time until disks i and j next have a pair event: the rule of ``pair``'s kind (see
-    the module docstring), or :func:`hard_core_time`."""
+def pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
+    """The next pair event of disks i and j as (time until it, event): the rule of ``pair``'s
+    kind (see the module docstring), or :func:`hard_core_time` and event 0."""
     if pair is None:
-        return hard_core_time(rx, ry, vx, vy, sigma, tau)
-    return RULES[type(pair)][0](pair, i, j, rx, ry, vx, vy, sigma, tau, disks)
+        return hard_core_time(rx, ry, vx, vy, sigma, tau), 0
+    return RULES[type(pair)].event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks)
 
 
 @overload(pair_event_time, inline="always")
-def _pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, disks):
+def _pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     if pair is types.none:
-        return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, disks: hard_core_time(
-            rx, ry, vx, vy, sigma, tau)
-    event_time = _rules_of(pair)[0]
-    return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, disks: event_time(
-        pair, i, j, rx, ry, vx, vy, sigma, tau, disks)
+        return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks: (
+            hard_core_time(rx, ry, vx, vy, sigma, tau), 0)
+    event_time = _rules_of(pair).event_time
+    return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks: event_time(
+        pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks)
 
 
-def apply_pair_event(pair, i, j, t, t_origin, disks, box, effects, tallies, contact):
-    """Apply the pair event of disks i and j at time t, the run's ``contact``-th contact, by
-    the rule of ``pair``'s kind; the loop calls it when :func:`own_apply`. Returns what
-    :func:`collide` returns."""
-    return RULES[type(pair)][1](pair, i, j, t, t_origin, disks, box, effects, tallies, contact)
+def apply_pair_event(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
+                     contact):
+    """Apply the pair event ``event`` of disks i and j at time t by the rule of ``pair``'s
+    kind; the loop calls it when :func:`own_apply`. Returns what :func:`collide` returns and
+    whether the event was a contact."""
+    return RULES[type(pair)].apply(pair, event, i, j, t, t_origin, disks, neighbours, box,
+                                   effects, tallies, contact)
 
 
 @overload(apply_pair_event, inline="always")
-def _apply_pair_event(pair, i, j, t, t_origin, disks, box, effects, tallies, contact):
-    apply = None if pair is types.none else _rules_of(pair)[1]
+def _apply_pair_event(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
+                      contact):
+    apply = None if pair is types.none else _rules_of(pair).apply
     if apply is None:  # typed for a kind without an apply rule of its own, never called
-        return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: (
-            0.0, 0.0, False, -1)
-    return lambda pair, i, j, t, t_origin, disks, box, effects, tallies, contact: apply(
-        pair, i, j, t, t_origin, disks, box, effects, tallies, contact)
+        return lambda pair, event, i, j, t, t_origin, disks, neighbours, box, effects, \
+            tallies, contact: (0.0, 0.0, False, -1, False)
+    return lambda pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies, \
+        contact: apply(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
+                       contact)
+
+
+def pair_reach(pair, i, disks):
+    """The reach a_i of disk i (see the module docstring): the rule of ``pair``'s kind, else
+    the radius R_i."""
+    if keeps(pair, "reach"):
+        return RULES[type(pair)].reach(pair, i, disks)
+    return disks.table[i, RADIUS]
+
+
+@overload(pair_reach, inline="always")
+def _pair_reach(pair, i, disks):
+    reach = None if pair is types.none else _rules_of(pair).reach
+    if reach is None:
+        return lambda pair, i, disks: disks.table[i, RADIUS]
+    return lambda pair, i, disks: reach(pair, i, disks)
+
+
+@njit(cache=True, inline="always")
+def pair_entry(neighbours, i, j):
+    """Where disk j stands in the neighbour list of disk i (an index into ``nb``); they must
+    be neighbours."""
+    k = list_start(neighbours.nb_start, i)
+    while neighbours.nb[k] != j:
+        k += 1
+    return k
+
+
+@njit(cache=True, inline="always")
+def pair_state(neighbours, i, j):
+    """The state of the neighbour pair (i, j) (``Neighbours.pair_state``)."""
+    return neighbours.pair_state[pair_entry(neighbours, i, j)]
+
+
+@njit(cache=True, inline="always")
+def set_pair_state(neighbours, i, j, state):
+    """Set the state of the neighbour pair (i, j): both its entries, in the lists of i and
+    of j."""
+    neighbours.pair_state[pair_entry(neighbours, i, j)] = state
+    neighbours.pair_state[pair_entry(neighbours, j, i)] = state
+
+
+def initial_pair_state(pair, i, j, rx, ry, sigma, disks):
+    """The state of the pair (i, j) at the engine's construction: the kind's
+    ``initial_state`` rule."""
+    return RULES[type(pair)].initial_state(pair, i, j, rx, ry, sigma, disks)
+
+
+@overload(initial_pair_state)
+def _initial_pair_state(pair, i, j, rx, ry, sigma, disks):
+    initial_state = _rules_of(pair).initial_state
+    return lambda pair, i, j, rx, ry, sigma, disks: initial_state(pair, i, j, rx, ry, sigma,
+                                                                  disks)
+
+
+@njit
+def initial_reaches(pair, disks, reach):
+    """Fill ``reach`` float64[n] with every disk's reach (:func:`pair_reach`), at the
+    engine's construction. Not cached: the kind may be defined outside sim
+    (:func:`sim.engine.compilation.cacheable`)."""
+    for i in range(reach.shape[0]):
+        reach[i] = pair_reach(pair, i, disks)
+
+
+@njit
+def initial_states(pair, disks, neighbours, box):
+    """Set the state of every neighbour pair by the kind's ``initial_state`` rule, every disk
+    at its own time 0 (the engine's construction). Not cached, as :func:`initial_reaches`."""
+    table = disks.table
+    for i in range(table.shape[0]):
+        start = list_start(neighbours.nb_start, i)
+        for k in range(start, start + neighbours.nb_count[i]):
+            j = neighbours.nb[k]
+            rx, ry = separation(box, table[i, X] - table[j, X], table[i, Y] - table[j, Y])
+            neighbours.pair_state[k] = initial_pair_state(
+                pair, i, j, rx, ry, table[i, RADIUS] + table[j, RADIUS], disks)
 
 
 @njit(cache=True, inline="always")

@@ -37,6 +37,12 @@ PAIRWISE_LIMIT = 2000
 class Running:
     """Advance the engine's state in time (the engine's running part)."""
 
+    def _disk_group(self):
+        """The disks as the compiled code takes them (:class:`sim.engine.groups.Disks`)."""
+        d = self.disks
+        return Disks(d.table, *self._per_disk_parameters(), d.stamp, d.counted, d.contacts,
+                     d.t_last, d.streak)
+
     def _run_chunk(self, max_events, max_contacts, max_collisions, t_stop, dissipation_limit):
         while True:
             d = self.disks
@@ -44,21 +50,23 @@ class Running:
             reorder_at = (self.counters[codes.EVENTS] // every + 1) * every
             parts = Parts(self.pair_interaction, self.system_event)
             arguments = (
-                Disks(d.table, *self._per_disk_parameters(), d.stamp, d.counted, d.contacts,
-                      d.t_last, d.streak),
-                Schedule(d.event_time, d.event_partner, d.event_stamp, *d.queue, d.system_time),
+                self._disk_group(),
+                Schedule(d.event_time, d.event_partner, d.event_stamp, *d.queue, d.system_time,
+                         d.pair_event),
                 self._neighbours(),
                 Box(self.geometry, self.grid),
                 self._effects(),
                 *parts,
+                True if self.lookahead else None,
                 Tallies(self.counters, self.accumulators, self.pair_collisions,
                         self.wall_impulse, self.stall_watch),
                 Limits(min(max_events, reorder_at), max_contacts, max_collisions, t_stop,
-                       dissipation_limit, self.stall_dt, self.rebase_every, self.lookahead))
+                       dissipation_limit, self.stall_dt, self.rebase_every))
             # the loop's variant is the engine's but for the lists' layout, which may change
-            layout = self._common_capacity is None
+            # (and the look-ahead, which a test may switch)
+            layout = (self._common_capacity is None, self.lookahead)
             run_events = loop.run_events if cacheable(*parts) else loop.run_events_uncached
-            if self._compiled_layout is not layout:
+            if self._compiled_layout != layout:
                 self.compile_seconds += compile_once(run_events, arguments)
                 self._compiled_layout = layout
             status, disk = run_events(*arguments)

@@ -19,6 +19,9 @@ Per-disk arrays (n disks, engine order):
   images int32[n, 2] — periodic windings (:mod:`sim.engine.flight`), or None when not counted.
   spin float64[n] — angular velocities (:mod:`sim.effects.rotation`), or None when no disk
   turns.
+  pair_event int32[n] — the name of each disk's pair event, reach float64[n] — each disk's
+      reach, pair_state int32 (beside nb) — each neighbour pair's state: each None unless the
+      scene's pair interaction has the rule that needs it (:mod:`sim.engine.pairs`).
 Other arrays: nb int32 (neighbour lists), heap int32[n], list_head int32[B + 1],
 calendar int64[3], block_rate float64[1], big int32[n_big], cell_head int32[cells],
 system_time float64[1] (:mod:`sim.engine.system`).
@@ -99,6 +102,9 @@ class DiskArrays:
     system_time: np.ndarray
     images: Optional[np.ndarray] = None
     spin: Optional[np.ndarray] = None
+    pair_event: Optional[np.ndarray] = None
+    reach: Optional[np.ndarray] = None
+    pair_state: Optional[np.ndarray] = None
 
     def __post_init__(self):
         self.pack()
@@ -138,7 +144,7 @@ class DiskArrays:
 
         old = self.arrays()
         new = self._fresh_buffer()
-        for name in PER_DISK + tuple(name for name in OPTIONAL_PER_DISK
+        for name in PER_DISK + tuple(name for name in OPTIONAL_PER_DISK + PAIR_PER_DISK
                                      if getattr(self, name) is not None):
             np.take(old[name], perm, axis=0, out=new[name])
         for name in ("heap", "list_head", "calendar", "block_rate", "big", "cell_head",
@@ -152,13 +158,19 @@ class DiskArrays:
         # neighbour lists: the same contents, ids remapped, one segment per disk in new order
         new["nb_start"][:] = list_starts(new["nb_cap"])
         new["nb"][:] = -1
+        if self.pair_state is not None:
+            new["pair_state"][:] = 0
         copy_lists(perm, new_id, old["nb_start"], old["nb_count"], old["nb"], new["nb_start"],
-                   new["nb"])
+                   new["nb"], old.get("pair_state"), new.get("pair_state"))
         for name, array in new.items():
             setattr(self, name, array)
 
 
-#: per-disk arrays of effects (the fields that default to None, each a field of
+#: per-disk arrays of a pair interaction (:mod:`sim.engine.pairs`), None unless it needs them
+PAIR_PER_DISK = ("pair_event", "reach")
+
+#: per-disk arrays of effects (the other fields that default to None, each a field of
 #: :class:`sim.effects.Effects` too): None when the effect is off; the engine keeps its other
 #: effect fields as attributes
-OPTIONAL_PER_DISK = tuple(f.name for f in fields(DiskArrays) if f.default is None)
+OPTIONAL_PER_DISK = tuple(f.name for f in fields(DiskArrays)
+                          if f.default is None and f.name not in PAIR_PER_DISK + ("pair_state",))
