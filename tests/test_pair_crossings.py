@@ -25,7 +25,7 @@ from sim.engine.kinematics import (
     may_touch_before,
     pair_contact_time,
 )
-from sim.engine.pairs import collide, rules, set_pair_state
+from sim.engine.pairs import collide, pair_state, rules, set_pair_state
 
 pytestmark = pytest.mark.slow
 
@@ -35,7 +35,8 @@ OUTSIDE, INSIDE = 0, 1  # a pair's states
 
 class Crossings(NamedTuple):
     ratio: float  # λ: a pair is inside while closer than λ σ_ij
-    counts: np.ndarray  # int64[3]: crossings inward at [INWARD], outward at [OUTWARD]
+    counts: np.ndarray  # int64[3]: crossings inward at [INWARD], outward at [OUTWARD], and at
+    # [CORE] the crossings whose direction the pair's state contradicts (none)
 
 
 @njit
@@ -71,8 +72,9 @@ def cross(value, event, i, j, t, t_origin, disks, neighbours, box, effects, tall
         lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
                                                   tallies, contact)
         return lost, virial, log_full, culprit, True
-    set_pair_state(neighbours, i, j, INSIDE if event == INWARD else OUTSIDE)
-    value.counts[event] += 1
+    side = pair_state(neighbours, i, j)
+    set_pair_state(neighbours, i, j, INSIDE if side == OUTSIDE else OUTSIDE)
+    value.counts[event if (side == OUTSIDE) == (event == INWARD) else CORE] += 1
     return 0.0, 0.0, False, -1, False
 
 
@@ -90,7 +92,9 @@ def initial_side(value, i, j, rx, ry, sigma, disks):
 rules(Crossings, crossing_time, cross, reach=crossing_reach, initial_state=initial_side)
 
 N = 400
-RATIO = 2.5  # beyond the default shells at φ = 0.3 (R + δ = 2.6 R)
+#: λ σ = 5 R, beyond the 2 R within which the shells of hard disks at φ = 0.3 (R + δ = 2.6 R,
+#: each disk within δ of its shell's centre) surely list a pair: the reach must do it
+RATIO = 2.5
 
 
 def counting_gas(ratio=RATIO):
@@ -140,7 +144,7 @@ def test_every_pair_state_says_on_which_side_its_pair_is():
         assert_states_hold(engine)
         assert_no_overlap(engine)
     assert counts[INWARD] - counts[OUTWARD] == len(inside_by_state(engine)) - start
-    assert counts[INWARD] > 10 * N and engine.collisions > 10 * N
+    assert counts[INWARD] > 10 * N and engine.collisions > 10 * N and counts[CORE] == 0
     # a crossing is an event, never a contact
     assert engine.events == engine.collisions + engine.counters[SHELL_EXITS] + counts[1:].sum()
     assert engine.contacts_by_disk().sum() == 2 * engine.collisions

@@ -61,6 +61,11 @@ class Checkpoints:
         if missing or unknown:
             raise ValueError(f"the checkpoint is not one of this scene's engine: arrays "
                              f"missing {missing}, unknown {unknown}")
+        if "disks/pair_state" in state and (np.shape(state["disks/pair_state"])
+                                            != np.shape(state["disks/nb"])):
+            raise ValueError(f"the checkpoint's disks/pair_state has shape "
+                             f"{np.shape(state['disks/pair_state'])}, its neighbour lists "
+                             f"disks/nb {np.shape(state['disks/nb'])}: they must be alike")
         for key, value in state.items():
             if key not in GROWING and np.shape(value) != mine[key]:
                 raise ValueError(f"the checkpoint's {key} has shape {np.shape(value)}, this "

@@ -43,9 +43,9 @@ def prefetch_upcoming(partner, walker, walker_block, disks, schedule, neighbours
     reach the heap top with nothing fetched). Returns the bucket walk's state.
 
     The loop calls it only for a scene of :data:`sim.engine.sizing.LOOKAHEAD_MIN_DISKS` disks
-    or more, and :func:`prefetch_next` with two slots otherwise: a look-ahead is a variant of
-    the loop of its own, and a smaller scene compiles none of it (3.5 s of the first
-    compilation of the default scene).
+    or more, and otherwise :func:`prefetch_next` for heap slots 1 and 2 (``slots`` = 3): the
+    look-ahead is a variant of the loop of its own, and a smaller scene compiles none of this
+    function (3.5 s of the first compilation of the default scene).
 
     Against :func:`prefetch_next` alone (``benchmarks/compare_builds.py``, φ = 0.5): 1.49
     at N = 1e5, 1.39 at 1e6, 1.11 at 5e4, but 0.94 at 3e4, where the state still sits mostly

@@ -30,13 +30,17 @@ it compiles the loop, so the registry is fixed at import. The rules are
 ``reach`` (optional; default the radius)
     ``reach(value, i, disks)``: a length a_i such that disks i and j have no event while they
     are more than a_i + a_j apart. The neighbour shells reach it
-    (:mod:`sim.engine.neighbours`), frozen per disk at each rebuild of its list.
-``initial_state`` (optional; a kind that has it keeps a state per pair)
+    (:mod:`sim.engine.neighbours`), frozen per disk at each rebuild of its list. It may
+    change from one rebuild to the next, but never beyond the largest reach at the engine's
+    construction, by which the cells and the periodic limit are sized.
+``initial_state`` (optional; a kind that has it keeps a state per pair, and only such a kind
+may call :func:`pair_state` and :func:`set_pair_state`)
     ``initial_state(value, i, j, rx, ry, sigma, disks)``: the state (an int32) of a pair at
-    the engine's construction, from its separation. From then on the events alone change it
-    (:func:`set_pair_state`); a pair that joins the neighbour lists later is farther apart
-    than its reach and starts at state 0. The state is kept beside the pair's entries of the
-    lists (``Neighbours.pair_state``), through rebuilds, renumbering and checkpoints.
+    the engine's construction, from its separation (asked once per pair, for i < j). From
+    then on the events alone change it (:func:`set_pair_state`); a pair that joins the
+    neighbour lists later was farther apart than its reach and starts at state 0. The state is
+    kept beside the pair's two entries of the lists (``Neighbours.pair_state``), through
+    rebuilds, renumbering and checkpoints.
 
 A kind without its own ``apply`` keeps no event of its own: its ``event`` is taken as a
 contact. A scene pays for what its kind has and nothing else: the event names, the reach
@@ -174,7 +178,7 @@ def _pair_reach(pair, i, disks):
     return lambda pair, i, disks: reach(pair, i, disks)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def pair_entry(neighbours, i, j):
     """Where disk j stands in the neighbour list of disk i (an index into ``nb``); they must
     be neighbours."""
@@ -184,16 +188,17 @@ def pair_entry(neighbours, i, j):
     return k
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def pair_state(neighbours, i, j):
     """The state of the neighbour pair (i, j) (``Neighbours.pair_state``)."""
     return neighbours.pair_state[pair_entry(neighbours, i, j)]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def set_pair_state(neighbours, i, j, state):
     """Set the state of the neighbour pair (i, j): both its entries, in the lists of i and
-    of j."""
+    of j. (A compiled function that the rules call, not inlined into them by numba, whose
+    inlining of a conditional expression given as ``state`` can drop its value.)"""
     neighbours.pair_state[pair_entry(neighbours, i, j)] = state
     neighbours.pair_state[pair_entry(neighbours, j, i)] = state
 
@@ -222,16 +227,18 @@ def initial_reaches(pair, disks, reach):
 
 @njit
 def initial_states(pair, disks, neighbours, box):
-    """Set the state of every neighbour pair by the kind's ``initial_state`` rule, every disk
-    at its own time 0 (the engine's construction). Not cached, as :func:`initial_reaches`."""
+    """Set the state of every neighbour pair (i < j, both its entries) by the kind's
+    ``initial_state`` rule, every disk at its own time 0 (the engine's construction). Not
+    cached, as :func:`initial_reaches`."""
     table = disks.table
     for i in range(table.shape[0]):
         start = list_start(neighbours.nb_start, i)
         for k in range(start, start + neighbours.nb_count[i]):
             j = neighbours.nb[k]
-            rx, ry = separation(box, table[i, X] - table[j, X], table[i, Y] - table[j, Y])
-            neighbours.pair_state[k] = initial_pair_state(
-                pair, i, j, rx, ry, table[i, RADIUS] + table[j, RADIUS], disks)
+            if j > i:
+                rx, ry = separation(box, table[i, X] - table[j, X], table[i, Y] - table[j, Y])
+                set_pair_state(neighbours, i, j, initial_pair_state(
+                    pair, i, j, rx, ry, table[i, RADIUS] + table[j, RADIUS], disks))
 
 
 @njit(cache=True, inline="always")

@@ -15,6 +15,7 @@ from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledErr
 from sim.engine.groups import Box, Disks, Limits, Parts, Schedule, Tallies
 from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
+from sim.engine.pairs import keeps
 
 #: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
 #: take about this many seconds, from the rate of the chunk before, so that the budget is kept
@@ -274,10 +275,13 @@ class Running:
     @property
     def conserves_kinetic_energy(self):
         """Whether the kinetic energy never changes: elastic smooth disks, elastic walls or
-        none, no gravity, still walls that are not thermal."""
+        none, no gravity, still walls that are not thermal, no pair interaction that applies
+        events of its own (a step of a potential) and no system event."""
         return not (self.restitution is not None or self.wall_contacts_dissipate
                     or self.roughness is not None or self.gravity is not None
-                    or self.wall_motion is not None or self.wall_temperature is not None)
+                    or self.wall_motion is not None or self.wall_temperature is not None
+                    or keeps(self.pair_interaction, "apply")
+                    or self.system_event is not None)
 
     def latest_time(self):
         """The latest time the engine can reach in the events left to it (2^62 in all), inf
