@@ -10,22 +10,34 @@ from sim.engine.queue import HEAP_SIZE, prefetch_next_block
 
 
 @njit(cache=True, inline="always")
-def prefetch_next(partner, slots, disks, schedule, neighbours):
-    """Ask the CPU to start loading the rows, next partners and list starts of the partner of
+def prefetch_next(partner, slots, deeper, disks, schedule, neighbours):
+    """Ask the CPU to start loading the row, next partner and list start of the partner of
     this event and of the disks in heap slots 1 … ``slots`` − 1, which the next events read
-    (hints only: no result changes)."""
-    table, stamp, nb = disks.table, disks.stamp, neighbours.nb
-    event_partner, heap = schedule.event_partner, schedule.heap
+    (hints only: no result changes); ``deeper`` (with the look-ahead): also the rows and
+    stamps of the partner's neighbours, and the stamps, queue links and list lengths of
+    those disks."""
+    table, stamp, nb, nb_count = disks.table, disks.stamp, neighbours.nb, neighbours.nb_count
+    event_partner, heap, links = schedule.event_partner, schedule.heap, schedule.links
     if partner >= 0:
         prefetch(table, partner)
         prefetch(stamp, partner)
-        prefetch(schedule.links, partner)
-        prefetch(nb, list_start(neighbours.nb_start, partner))
+        prefetch(links, partner)
+        start = list_start(neighbours.nb_start, partner)
+        prefetch(nb, start)
+        if deeper:
+            for k in range(start, start + nb_count[partner]):
+                prefetch(table, nb[k])
+                prefetch(stamp, nb[k])
     for slot in range(1, min(slots, schedule.calendar[HEAP_SIZE])):
         c = heap[slot]
         prefetch(table, c)
         prefetch(event_partner, c)
         prefetch(nb, list_start(neighbours.nb_start, c))
+        if deeper:
+            prefetch(schedule.event_stamp, c)
+            prefetch(stamp, c)
+            prefetch(links, c)
+            prefetch(nb_count, c)
 
 
 @njit(cache=True, inline="always")
@@ -34,18 +46,18 @@ def prefetch_upcoming(partner, walker, walker_block, disks, schedule, neighbours
     for states larger than the caches (hints only: no result changes). A disk's data is hinted
     in stages, one event apart, each stage reading what the one before brought in: the partner
     of this event and its neighbours' rows and stamps; the disks of the next three in the heap
-    (:func:`prefetch_next`, and their stamps, links and list lengths); for the next two the rows
-    their predictions read (their neighbours' rows and stamps), their partners' data, or, for
-    a shell exit, the cells it scans, its own cell links and the lists and counts of its
-    neighbours, which its rebuild edits; and the bucket that becomes the heap next
+    (:func:`prefetch_next`, deeper); for the next two the rows their predictions read (their
+    neighbours' rows and stamps), their partners' data, or, for a shell exit, the cells it
+    scans, its own cell links and the lists and counts of its neighbours, which its rebuild
+    edits; and the bucket that becomes the heap next
     (:func:`sim.engine.queue.prefetch_next_block`: one of its disks per event, whose row,
     partner and list are hinted too, for the first events of the next block would otherwise
     reach the heap top with nothing fetched). Returns the bucket walk's state.
 
     The loop calls it only for a scene of :data:`sim.engine.sizing.LOOKAHEAD_MIN_DISKS` disks
-    or more, and otherwise :func:`prefetch_next` for heap slots 1 and 2 (``slots`` = 3): the
-    look-ahead is a variant of the loop of its own, and a smaller scene compiles none of this
-    function (3.5 s of the first compilation of the default scene).
+    or more, and otherwise :func:`prefetch_next` for heap slots 1 and 2 (``slots`` = 3, not
+    deeper): the look-ahead is a variant of the loop of its own, and a smaller scene compiles
+    none of this function (3.5 s of the first compilation of the default scene).
 
     Against :func:`prefetch_next` alone (``benchmarks/compare_builds.py``, φ = 0.5): 1.49
     at N = 1e5, 1.39 at 1e6, 1.11 at 5e4, but 0.94 at 3e4, where the state still sits mostly
@@ -62,19 +74,8 @@ def prefetch_upcoming(partner, walker, walker_block, disks, schedule, neighbours
     event_partner, event_stamp, heap, links = (schedule.event_partner, schedule.event_stamp,
                                                schedule.heap, schedule.links)
     nb_start, nb_count, nb = neighbours.nb_start, neighbours.nb_count, neighbours.nb
-    prefetch_next(partner, 4, disks, schedule, neighbours)
-    if partner >= 0:
-        start = list_start(nb_start, partner)
-        for k in range(start, start + nb_count[partner]):
-            prefetch(table, nb[k])
-            prefetch(stamp, nb[k])
+    prefetch_next(partner, 4, True, disks, schedule, neighbours)
     size = schedule.calendar[HEAP_SIZE]
-    for slot in range(1, min(4, size)):
-        c = heap[slot]
-        prefetch(event_stamp, c)
-        prefetch(stamp, c)
-        prefetch(links, c)
-        prefetch(nb_count, c)
     for slot in range(1, min(3, size)):
         c = heap[slot]
         partner_c = event_partner[c]

@@ -335,7 +335,7 @@ def run_events(disks, schedule, neighbours, box, effects, pair, system, lookahea
             break
         t_previous = t
         if lookahead is None:
-            prefetch_next(partner, 3, disks, schedule, neighbours)
+            prefetch_next(partner, 3, False, disks, schedule, neighbours)
         else:
             walker, walker_block = prefetch_upcoming(partner, walker, walker_block, disks,
                                                      schedule, neighbours, box)
