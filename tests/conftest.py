@@ -16,6 +16,7 @@ import variants
 from sim.checks.audit import outside_box, overlapping_pairs
 from sim.checks.rows import table
 from sim.engine import Boundary, Engine
+from sim.engine.box import nearest_images
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,
@@ -51,6 +52,14 @@ def gas(n, phi, periodic=(False, False), seed=0, speed=1.0, **engine_options):
     velocity = fixed_speed(n, speed, seed=seed + 1)
     return Engine(position, velocity, radius, boundary=Boundary(periodic=periodic),
                   **engine_options)
+
+
+def distances(engine):
+    """Every distance between two disks float64[n, n] at the engine's current time, through
+    the nearest periodic image (user order)."""
+    position = engine.positions()
+    r = nearest_images(position[:, None, :] - position[None, :, :], engine.box, engine.periodic)
+    return np.hypot(r[..., 0], r[..., 1])
 
 
 def assert_no_overlap(engine, tolerance=1e-9):

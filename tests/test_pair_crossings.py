@@ -16,8 +16,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from conftest import assert_no_overlap, gas
-from sim.engine.box import nearest_images
+from conftest import assert_no_overlap, distances, gas
 from sim.engine.codes import SHELL_EXITS
 from sim.engine.kinematics import (
     INF,
@@ -118,9 +117,7 @@ def inside_by_state(engine):
 
 def inside_by_distance(engine, slack):
     """The pairs (i < j) closer than λ σ (1 − slack), and those closer than λ σ (1 + slack)."""
-    r = nearest_images(engine.positions()[:, None, :] - engine.positions()[None, :, :],
-                       engine.box, engine.periodic)
-    distance = np.hypot(r[..., 0], r[..., 1]) / (2 * RATIO * engine.radius[0])
+    distance = distances(engine) / (2 * RATIO * engine.radius[0])
     upper = np.triu(np.ones((engine.n, engine.n), bool), 1)
     surely = np.argwhere(upper & (distance < 1.0 - slack))
     maybe = np.argwhere(upper & (distance < 1.0 + slack))

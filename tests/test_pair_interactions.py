@@ -12,8 +12,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from conftest import gas
-from sim.engine.box import nearest_images
+from conftest import distances, gas
 from sim.engine.kinematics import INF, may_touch_before, pair_contact_time
 from sim.engine.pairs import rules
 from sim.engine.parameters import per_disk
@@ -47,9 +46,7 @@ def mixture(pair_interaction):
 
 def closest(engine):
     """The smallest distance over σ_ij of like pairs and of unlike pairs (nearest images)."""
-    r = nearest_images(engine.positions()[:, None, :] - engine.positions()[None, :, :],
-                       engine.box, engine.periodic)
-    distance = np.hypot(r[..., 0], r[..., 1]) / (2 * engine.radius[0])
+    distance = distances(engine) / (2 * engine.radius[0])
     np.fill_diagonal(distance, np.inf)
     unlike = (np.arange(N)[:, None] % 2) != (np.arange(N)[None, :] % 2)
     return distance[~unlike].min(), distance[unlike].min()

@@ -222,10 +222,12 @@ class Engine(Running, Observables, Checkpoints):
                                   lead])
         self.grid = np.array([cells[0], cells[1], int(self.periodic[0]), int(self.periodic[1])],
                              dtype=np.int64)
+        self._box_group = Box(self.geometry, self.grid)  # as the compiled code takes them
         # list capacity: the expected number of overlapping shells, 4 φ (a/R + δ/R)² (a the
         # median reach, R the median radius), plus three standard deviations of its (at most
         # Poisson) fluctuations and a margin; the rare list that overflows grows on demand
-        expected = 4.0 * phi_small * (float(np.median(a)) / median + delta_small / median) ** 2
+        a_median = median if reaches is None else float(np.median(reaches))
+        expected = 4.0 * phi_small * (a_median / median + delta_small / median) ** 2
         if list_capacity is None:
             list_capacity = int(4 * math.ceil((expected + 3.0 * math.sqrt(expected) + 4.0) / 4))
         cap = np.full(n, max(list_capacity, 1), dtype=np.int32)
@@ -247,13 +249,12 @@ class Engine(Running, Observables, Checkpoints):
         shell_radius = self._per_disk_parameters()[0]
         while True:
             full = build_all_neighbours(d.table, shell_radius, d.is_big, self._neighbours(),
-                                        Box(self.geometry, self.grid), self.lookahead)
+                                        self._box_group, self.lookahead)
             if full < 0:
                 break
             self._grow_lists(full)
         if d.pair_state is not None:
-            initial_states(pair, self._disk_group(), self._neighbours(),
-                           Box(self.geometry, self.grid))
+            initial_states(pair, self._disk_group(), self._neighbours(), self._box_group)
         # first predictions: every disk queued at t = 0 and predicted by the event loop itself
         # (with the argument types of every later call) in a call that may apply no event;
         # then the queue is sized for the predicted events. Until then its blocks are sized

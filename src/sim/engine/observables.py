@@ -10,7 +10,6 @@ from sim.effects.gravity import potential_energy
 from sim.effects.rotation import moment_of_inertia, rotational_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
-from sim.engine.groups import Box
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
 from sim.engine.stamps import count_all_contacts
 
@@ -64,8 +63,8 @@ class Observables:
                 else float(t) - self.accumulators[codes.T_ORIGIN])
 
     def _state(self, t):
-        return loop.state_at(self._relative_time(t), self.disks.table,
-                             Box(self.geometry, self.grid), self.gravity)
+        return loop.state_at(self._relative_time(t), self.disks.table, self._box_group,
+                             self.gravity)
 
     def positions(self, t=None):
         """Positions float64[n, 2] of every disk at absolute time ``t`` (default: the time of

@@ -12,7 +12,7 @@ from sim.effects.walls import piston_jam
 from sim.engine import codes, loop
 from sim.engine.compilation import cacheable, compile_once
 from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
-from sim.engine.groups import Box, Disks, Limits, Parts, Schedule, Tallies
+from sim.engine.groups import Disks, Limits, Parts, Schedule, Tallies
 from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 from sim.engine.pairs import keeps
@@ -55,7 +55,7 @@ class Running:
                 Schedule(d.event_time, d.event_partner, d.event_stamp, *d.queue, d.system_time,
                          d.pair_event),
                 self._neighbours(),
-                Box(self.geometry, self.grid),
+                self._box_group,
                 self._effects(),
                 *parts,
                 True if self.lookahead else None,
