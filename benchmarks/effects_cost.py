@@ -48,6 +48,7 @@ EFFECTS = {
     "pressure_tensor": ({}, {}, {"pressure_tensor": False}, {"pressure_tensor": True}),
     "event_log": ({}, {}, {"event_log": None}, {"event_log": 1 << 16}),
     "rotation": ({}, {}, {"tangential_restitution": -1.0}, {"tangential_restitution": 0.5}),
+    "growth": ({}, {}, {"growth_rate": 0.0}, {"growth_rate": 0.01}),
     "friction": ({"tangential_restitution": 0.5}, {}, {"friction": math.inf},
                  {"friction": 0.3}),
 }

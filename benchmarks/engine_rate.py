@@ -139,7 +139,7 @@ def crater_rows(collisions, seed=1):
             engine.run(collisions=collisions, energy_fraction=0.1)
             seconds = time.perf_counter() - started
         rows.append({"scene": "crater" if with_projectile else "crater bed, no projectile",
-                     "n": engine.n, "phi": round(engine.packing_fraction, 3),
+                     "n": engine.n, "phi": round(engine.packing_fraction(), 3),
                      "collisions_per_s": round(engine.collisions / seconds),
                      "best_chunk_collisions_per_s": None,
                      "events_per_s": round(engine.events / seconds),

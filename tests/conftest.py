@@ -65,10 +65,10 @@ def distances(engine):
 def assert_no_overlap(engine, tolerance=1e-9):
     """Independent all-pairs audit (k-d tree) at the engine's current time."""
     position = engine.positions()
-    pairs, overlap = overlapping_pairs(position, engine.radius, engine.box, engine.periodic,
+    pairs, overlap = overlapping_pairs(position, engine.radii(), engine.box, engine.periodic,
                                        tolerance)
     assert pairs.size == 0, f"overlapping pairs {pairs[:5].tolist()}, overlaps {overlap[:5]}"
-    escaped = outside_box(position, engine.radius, engine.box, engine.periodic, tolerance,
+    escaped = outside_box(position, engine.radii(), engine.box, engine.periodic, tolerance,
                           engine.wall_positions())
     assert escaped.size == 0, f"disks outside the box: {escaped[:5].tolist()}"
 

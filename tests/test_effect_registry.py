@@ -134,6 +134,8 @@ def test_loop_values_fill_exactly_the_effects_fields():
                "radius": np.full(2, 0.1), "mass": np.ones(2), "initial_energy": 1.0}
     for effect in EFFECTS:
         values = effect.module.loop_values(keywords, context)
+        # and an effect's system event (sim.effects docstring), none with these defaults
+        assert values.pop("system_event", None) is None, effect.name
         assert tuple(values) == effect.fields, effect.name
         context.update(values)
 

@@ -34,7 +34,7 @@ def contact(disks, spin, m_i, m_j, xi, q, beta, friction):
     rx = disks[0, X] - disks[1, X]
     ry = disks[0, Y] - disks[1, Y]
     r = math.sqrt(rx * rx + ry * ry)
-    lost_n, virial = collide_disks(0, 1, rx, ry, xi, disks, m_i, m_j)
+    lost_n, virial = collide_disks(0, 1, rx, ry, xi, disks, m_i, m_j, None)
     lost_t = rough_contact(0, 1, rx / r, ry / r, virial / r, disks, spin, m_i, m_j, q, beta,
                            friction)
     return lost_n, lost_t
@@ -234,7 +234,7 @@ def test_smooth_contact_leaves_spins_and_tangential_motion_alone(c):
     """β = −1 without friction is the smooth contact, bit for bit."""
     disks, spin, *_ = run(c, beta=SMOOTH, friction=None)
     smooth = pair(c["angle"], *c["a"], c["v"][:2], c["v"][2:])
-    collide_disks(0, 1, *(smooth[0, X:Y + 1] - smooth[1, X:Y + 1]), c["xi"], smooth, *c["m"])
+    collide_disks(0, 1, *(smooth[0, X:Y + 1] - smooth[1, X:Y + 1]), c["xi"], smooth, *c["m"], None)
     assert np.array_equal(disks, smooth)
     assert np.array_equal(spin, c["spin"])
     wall = smooth.copy()[:1]
@@ -294,7 +294,7 @@ def collisional_averages(normals, angles, xi, beta, q, t_tr, t_rot):
         nx, ny = math.cos(angles[k]), math.sin(angles[k])
         e_tr = 0.5 * m * np.sum(disks[:, VX:VY + 1] ** 2)
         e_rot = 0.5 * inertia * np.sum(spin**2)
-        _, p_n = collide_disks(0, 1, nx, ny, xi, disks, m, m)  # |r| = 1: virial = P_n
+        _, p_n = collide_disks(0, 1, nx, ny, xi, disks, m, m, None)  # |r| = 1: virial = P_n
         if p_n == 0.0:  # separating pairs do not collide
             continue
         w[k] = p_n

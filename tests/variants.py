@@ -31,6 +31,7 @@ crater            ``restitution``, ``wall_restitution``, ``tc``; masses and spec
 settling_bed      ``restitution``, ``wall_restitution``, ``tc`` and ``gravity``, every disk alike
 rough_cooling     ``restitution``, ``tangential_restitution`` (rough, no friction) and ``tc``
 observers         ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk alike
+compress          ``growth`` (and its system event, the rescaling); radii and species per disk
 gas_lookahead     gas, looking ahead
 crater_lookahead  crater, looking ahead
 ================  ==============================================================================
@@ -50,6 +51,7 @@ SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
 
 #: overrides that make a scene small enough for a quick test (same compiled variant)
 SHRINK = {"gas": ["disks.n=300"], "mixture": ["disks.n=300"], "cooling": ["disks.n=300"],
+          "compress": ["disks.n=300"],
           "driven": ["disks.n=300"], "vibrated_bed": ["bed.n=100"],
           "crater": ["bed.n=400", "projectile.radius=0.02"],
           "crater_gravity": ["bed.n=300", "bed.radius=0.012", "bed.settle_time=0.5"]}
@@ -75,7 +77,8 @@ SLOW_SCENARIOS = ("crater_gravity",)
 #: alike under gravity with the TC model: disks at rest on a still floor) and a gas with every
 #: recorder on
 CANONICAL = {**{scene: (scene,) for scene in ("gas", "mixture", "cooling", "driven",
-                                               "vibrated_bed", "crater", "rough_cooling")},
+                                               "vibrated_bed", "crater", "rough_cooling",
+                                               "compress")},
              "settling_bed": ("gas", "gravity=[0,-1]", "restitution.disk=0.9",
                               "restitution.wall=0.9", "tc.time=1e-4"),
              "observers": ("gas", *OBSERVERS),

@@ -305,6 +305,14 @@ def pressure_tensor(run):
                         attrs={"unit": "energy/area"})
 
 
+def global_bond_order(run):
+    """|Ψ₆| = |⟨ψ₆⟩| over the disks at every snapshot of a run that observed ψ₆
+    (``observe.bond_order=true``, :class:`sim.analysis.observers.BondOrder`): a DataArray
+    over time."""
+    psi = run["bond_order"].sel(part=b"re") + 1j * run["bond_order"].sel(part=b"im")
+    return abs(psi.mean("disk")).rename("global_bond_order")
+
+
 def velocity_autocorrelation(run, max_lag):
     """⟨v(t₀ + τ)·v(t₀)⟩ per species, averaged over every snapshot as time origin t₀, for lags
     of 0 … ``max_lag`` snapshots. Snapshots must be evenly spaced in time (``output.every_time``).
@@ -345,5 +353,5 @@ def contacts(path):
                       coords={"contact": rows[:, 5].astype(np.int64)})
 
 
-__all__ = ["at_last_snapshot", "contacts", "granular_temperatures", "open_run", "open_sweep",
-           "pressure_tensor", "velocity_autocorrelation"]
+__all__ = ["at_last_snapshot", "contacts", "global_bond_order", "granular_temperatures",
+           "open_run", "open_sweep", "pressure_tensor", "velocity_autocorrelation"]

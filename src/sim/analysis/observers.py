@@ -17,6 +17,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from sim.analysis.cells import cell_index, granular_temperature, grid
+from sim.analysis.packing import bond_order
 from sim.checks.audit import kd_tree
 from sim.pipeline.config import ConfigError
 
@@ -73,9 +74,7 @@ class Clusters:
     coords = {}
 
     def __init__(self, gap, engine):
-        self.radius = np.asarray(engine.radius, dtype=np.float64)
-        self.reach = 2.0 * float(self.radius.max()) + gap * 2.0 * float(self.radius.mean())
-        self.gap = gap * 2.0 * float(self.radius.mean())
+        self.gap = gap * 2.0 * float(engine.radius.mean())
         self.shape = (engine.n,)
         self.description = (f"cluster label of each disk (0 = largest), disks linked below a "
                             f"gap of {gap} × 2⟨R⟩")
@@ -83,9 +82,11 @@ class Clusters:
         self.periodic = engine.periodic
 
     def __call__(self, engine, t, position, velocity):
+        radius = engine.radii(t)  # growing disks grow (sim.effects.growth)
         tree = kd_tree(position, self.box, self.periodic)
-        close = tree.sparse_distance_matrix(tree, self.reach, output_type="ndarray")
-        linked = close["v"] < self.radius[close["i"]] + self.radius[close["j"]] + self.gap
+        close = tree.sparse_distance_matrix(tree, 2.0 * float(radius.max()) + self.gap,
+                                            output_type="ndarray")
+        linked = close["v"] < radius[close["i"]] + radius[close["j"]] + self.gap
         n = position.shape[0]
         graph = coo_matrix((np.ones(linked.sum()), (close["i"][linked], close["j"][linked])),
                            shape=(n, n))
@@ -94,6 +95,28 @@ class Clusters:
         rank = np.empty_like(sizes)
         rank[np.argsort(-sizes, kind="stable")] = np.arange(sizes.size)
         return rank[labels].astype(np.int32)
+
+
+class BondOrder:
+    """The bond-orientational order ψ₆ of every disk over its Voronoi neighbours
+    (:func:`sim.analysis.packing.bond_order`), as its real and imaginary parts; the global
+    |Ψ₆| is the modulus of their mean (:func:`sim.analysis.datasets.global_bond_order`)."""
+
+    name = "bond_order"
+    unit = "1"
+    dtype = np.float64
+    dims = ("disk", "part")
+    coords = {"part": np.array([b"re", b"im"])}
+    description = "ψ₆ of each disk over its Voronoi neighbours, [disk, (re, im)]"
+
+    def __init__(self, engine):
+        self.shape = (engine.n, 2)
+        self.box = engine.box
+        self.periodic = engine.periodic
+
+    def __call__(self, engine, t, position, velocity):
+        psi = bond_order(position, self.box, self.periodic)
+        return np.stack([psi.real, psi.imag], axis=1)
 
 
 class LocalFields:
@@ -120,13 +143,13 @@ class LocalFields:
                        "y": (np.arange(ny) + 0.5) * width[1]}
         self.description = ("packing fraction and granular temperature (./field) on "
                             f"{nx} × {ny} cells; cell centres in ./x, ./y")
-        self.disk_area = np.pi * np.asarray(engine.radius, dtype=np.float64) ** 2
         self.mass = np.asarray(engine.mass, dtype=np.float64)
 
     def __call__(self, engine, t, position, velocity):
         cell = cell_index(position, self.box, self.grid)
         n_cells = self.grid[0] * self.grid[1]
-        packing = np.bincount(cell, weights=self.disk_area, minlength=n_cells) / self.cell_area
+        disk_area = np.pi * engine.radii(t) ** 2  # growing disks grow (sim.effects.growth)
+        packing = np.bincount(cell, weights=disk_area, minlength=n_cells) / self.cell_area
         temperature = granular_temperature(velocity, self.mass, cell, n_cells)
         return np.stack([packing, temperature]).reshape(self.shape)
 
@@ -237,4 +260,6 @@ def from_config(cfg, engine):
         observers.append(VelocityAutocorrelation(engine))
     if cfg.observe.pressure_tensor:
         observers += [KineticTensor(engine), VirialTensor(engine)]
+    if cfg.observe.bond_order:
+        observers.append(BondOrder(engine))
     return observers

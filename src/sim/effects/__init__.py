@@ -20,7 +20,9 @@ The protocol: every effect module defines
 ``loop_values(keywords, context)``
     its fields of :class:`Effects`, {field: value, None when off or neutral}, from every
     effect's keywords and the ``context``: the scene (n, n_species, box, periodic, radius,
-    mass, initial_energy) and the fields of the effects before it in :data:`EFFECTS`.
+    mass, initial_energy) and the fields of the effects before it in :data:`EFFECTS`; and,
+    for an effect that acts on the whole system at times (growth's rescaling), the key
+    ``system_event``: its system event (:mod:`sim.engine.system`), or None.
 
 The functions below run the protocol over every effect, in the order of :data:`EFFECTS`.
 """
@@ -71,6 +73,11 @@ EFFECTS = (
     Effect("thermal_walls", ("wall_temperature", "seed"),
            ("seed", "box.boundary") + tuple(f"{wall}.temperature" for wall in WALL_SECTIONS),
            ("thermal_walls",), ("thermal_walls",)),
+    Effect("growth", ("growth",), ("growth.rate", "growth.rescale_every",
+                                   "restitution.tangential", "friction.mu")
+           + tuple(f"{wall}.{key}" for wall in WALL_SECTIONS
+                   for key in ("temperature", "speed", "amplitude")),
+           ("test_growth.py::test_growing_gas_never_overlaps",), ("growth",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
            ("test_observers.py::test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots",),
            ("unwrap",)),
@@ -87,7 +94,10 @@ EFFECTS = (
 #: gravity float64[2], wall_motion float64[4, 3], wall_temperature float64[4], seed int,
 #: images int32[n, 2], virial_tensor float64[3], event_log (float64[rows, 6], int64[1]),
 #: roughness :class:`sim.effects.rotation.Roughness`, friction
-#: :class:`sim.effects.rotation.Friction`, spin float64[n].
+#: :class:`sim.effects.rotation.Friction`, spin float64[n], growth
+#: :class:`sim.effects.growth.Growth`. An effect's ``loop_values`` may also return the key
+#: ``system_event``: the system event (:mod:`sim.engine.system`) the effect needs, which the
+#: engine runs (growth's rescaling).
 Effects = namedtuple("Effects", [field for effect in EFFECTS for field in effect.fields])
 
 

@@ -28,7 +28,6 @@ from sim.engine.box import SIDE, WALL_NAMES
 from sim.engine.inputs import WALLS, wall_keyword
 from sim.engine.kinematics import (
     INF,
-    RADIUS,
     VX,
     X,
     first_contact_accelerated,
@@ -223,12 +222,27 @@ def moving_wall_work(motion, m, v_after, v_before, lost):
     return 0.5 * m * (v_after**2 - v_before * v_before) + lost
 
 
+def edge_velocity(u, sign, edge):
+    """The velocity of a wall at u seen by a disk whose edge moves out from its centre at
+    ``edge`` (a growing disk, :mod:`sim.effects.growth`): u + sign Ṙ; u itself for a disk that
+    does not grow (``edge`` None, compiled away)."""
+    return u if edge is None else u + sign * edge
+
+
+@overload(edge_velocity, inline="always")
+def _edge_velocity(u, sign, edge):
+    if edge is types.none:
+        return lambda u, sign, edge: u
+    return lambda u, sign, edge: u + sign * edge
+
+
 @njit(cache=True, inline="always")
-def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, motion, temperature, key, gravity,
-             tc):
-    """Disk i (mass m, at the time of contact) touches ``wall``: clamp it inside the wall
-    against round-off, then reflect it, v_n' − u = −ξ_w (v_n − u) in the frame of the wall
-    moving at u (hard wall), or redraw its velocity (thermal wall).
+def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, effects, key, radius, edge):
+    """Disk i (mass m, radius ``radius``, at the time of contact) touches ``wall``: clamp it
+    inside the wall against round-off, then reflect it, v_n' − u = −ξ_w (v_n − u) in the
+    frame of the wall moving at u (hard wall; for a disk growing at Ṙ = ``edge`` the frame of
+    its edge, u + sign Ṙ), or redraw its velocity (thermal wall). The walls' effects
+    (``wall_motion``, ``wall_temperature``, ``gravity``, ``tc``) come from ``effects``.
 
     Returns (energy dissipated, momentum given to the wall along its axis, work done by the
     wall on the disk), so that E_kin changes by work − dissipated. A disk found receding
@@ -236,22 +250,24 @@ def hit_wall(i, wall, t_abs, xi_wall, disks, m, geometry, motion, temperature, k
     and the TC model (:func:`sim.effects.gravity.resting_lift`); without that model such a
     disk stalls the clock (:class:`sim.engine.errors.StalledError`).
     """
+    motion = effects.wall_motion
     axis = wall >> 1
     other = 1 - axis
     sign = 1.0 - 2.0 * (wall & 1)
     position, u = wall_state(motion, wall, t_abs, geometry)
-    inside = position + sign * disks[i, RADIUS]
+    inside = position + sign * radius
     if sign * (disks[i, X + axis] - inside) < 0.0:
         disks[i, X + axis] = inside
     v_n = disks[i, VX + axis]
     v_t = disks[i, VX + other]
-    redrawn, impulse, work = thermal_redraw(temperature, key, wall, u, sign, m, disks, i,
-                                            v_n, v_t)
+    redrawn, impulse, work = thermal_redraw(effects.wall_temperature, key, wall, u, sign, m,
+                                            disks, i, v_n, v_t)
     if redrawn:
         return 0.0, impulse, work
+    u = edge_velocity(u, sign, edge)
     w_n = v_n - u
     if sign * w_n >= 0.0:
-        lifted, lift = resting_lift(gravity, tc, motion, disks, i, axis, sign)
+        lifted, lift = resting_lift(effects.gravity, effects.tc, motion, disks, i, axis, sign)
         if lifted:
             return 0.0, -m * lift, 0.5 * m * lift * lift
         return 0.0, 0.0, 0.0

@@ -47,6 +47,8 @@ class Checkpoints:
                      initial_energy=np.array(self.initial_energy))
         if self.virial_tensor is not None:
             state["virial_tensor"] = self.virial_tensor
+        if getattr(self.system_event, "state", None) is not None:
+            state["system_state"] = self.system_event.state  # a system kind's own state
         return state
 
     def load_state_dict(self, state):
@@ -76,6 +78,8 @@ class Checkpoints:
                 setattr(self.disks, key.removeprefix("disks/"), value)
             elif key == "initial_energy":
                 self.initial_energy = float(value)
+            elif key == "system_state":
+                self.system_event.state[:] = value
             else:
                 setattr(self, key, value)
         self._common_capacity = common_value(self.disks.nb_cap)

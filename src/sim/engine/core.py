@@ -123,6 +123,7 @@ class Engine(Running, Observables, Checkpoints):
             "n": n, "n_species": self.n_species, "box": box, "periodic": periodic,
             "radius": radius, "mass": mass, "initial_energy": self.initial_energy})
         disk_effects = {field: values.pop(field) for field in OPTIONAL_PER_DISK}
+        effect_system = values.pop("system_event")
         for field, value in values.items():
             setattr(self, field, value)
         # the far edge of the disks, whose ulps bound those of their coordinates (a disk
@@ -145,6 +146,14 @@ class Engine(Running, Observables, Checkpoints):
             if value is not None and type(value) not in registry:
                 raise refused("Engine", name, value, f"None, or a value of a kind registered "
                               f"with {register} (a {type(value).__name__} is none)")
+        if effect_system is not None:
+            if system_event is not None:
+                raise refused("Engine", "system_event", system_event, "None for growing disks, "
+                              "whose rescaling of the velocities is the system event")
+            system_event = effect_system
+        if self.growth is not None and pair_interaction is not None:
+            raise refused("Engine", "pair_interaction", pair_interaction,
+                          "None for growing disks: they grow hard cores")
         self.pair_interaction = pair_interaction
         self.system_event = system_event
         self.radius = radius
@@ -182,27 +191,33 @@ class Engine(Running, Observables, Checkpoints):
         table[:, X:Y + 1] = position
         table[:, VX:VY + 1] = velocity
         table[:, RADIUS] = radius
-        # how far each disk's pair events reach (sim.engine.pairs): its radius for hard disks
-        reaches = self._initial_reaches(table) if keeps(pair, "reach") else None
+        # how far each disk's pair events reach (sim.engine.pairs): its radius for hard disks,
+        # frozen at each rebuild for growing ones (sim.effects.growth)
+        reaches = (self._initial_reaches(table) if keeps(pair, "reach")
+                   else radius.copy() if self.growth is not None else None)
         a = radius if reaches is None else reaches
         median = float(np.median(radius))
+        phi = float(np.pi * np.sum(radius**2) / np.prod(box))
+        # growing disks: shells, cells and the periodic limit sized for the largest radii
+        # the box holds, R_i(0) s_max (packing fraction 1, or the periodic limit)
+        self.largest_scale = self._largest_scale(phi, a)
+        a_sizing = a * self.largest_scale
         big = np.flatnonzero(radius > BIG_RADIUS_RATIO * median)
         if big.size > MAX_BIG:
             big = big[:0]
         is_big = np.zeros(n, dtype=bool)
         is_big[big] = True
         small_radius = radius[~is_big]
-        phi = float(np.pi * np.sum(radius**2) / np.prod(box))
         # shells and lists concern the small disks, where they are
         phi_small = packing_fraction_around_disks(position[~is_big], small_radius, box)
         ratio = shell_ratio(phi_small) if shell is None else shell
         lead = shell_lead(phi_small) if lead is None else lead
         delta_small = 0.5 * (ratio - 1.0) * 2.0 * median
-        max_small = float(a[~is_big].max())
+        max_small = float(a_sizing[~is_big].max())
         # the two largest reaches: two disks whose shells overlap are less than
         # a_i + a_j + 4 δ apart (shell centres within a_i + δ + a_j + δ, each disk within δ of
         # its centre)
-        r_2, r_1 = (np.sort(a)[-2:] if n > 1 else (0.0, a[0]))
+        r_2, r_1 = (np.sort(a_sizing)[-2:] if n > 1 else (0.0, a_sizing[0]))
         for axis in range(2):
             if self.periodic[axis]:
                 # predictions take the nearest image of a separation: that is the image in
@@ -233,12 +248,11 @@ class Engine(Running, Observables, Checkpoints):
         cap = np.full(n, max(list_capacity, 1), dtype=np.int32)
         if big.size:
             density = max(phi_small, 0.6) / (np.pi * median**2)
-            reach_big = a[big] + delta[big] + reach
+            reach_big = a_sizing[big] + delta[big] + reach
             cap[big] = (2.0 * density * np.pi * reach_big**2 + 16).astype(np.int32)
         self.disks = self._initial_state(table, delta, is_big, big, cap,
                                          int(cells[0] * cells[1]), disk_effects, reaches)
         del table  # copied into the state's buffer
-        self.packing_fraction = phi
         d = self.disks
         # per-disk values every disk shares (None where they differ): the compiled code gets
         # the number, and never loads the array (sim.engine.parameters); delta, mass and species
@@ -274,6 +288,19 @@ class Engine(Running, Observables, Checkpoints):
         self.stall_watch[:] = (-math.inf, 0.0)  # the first predictions, all at t = 0, are no run
         if n >= REORDER_MIN_DISKS:
             self.reorder()
+
+    def _largest_scale(self, phi, reach):
+        """The largest factor s_max by which growing disks may grow (1 without growth): the
+        radii at packing fraction 1, or within the periodic limit R_1 + R_2 < L/2 (with room
+        for shells: s (R_1 + R_2) ≤ 0.45 L), whichever comes first."""
+        if self.growth is None:
+            return 1.0
+        largest = 1.0 / math.sqrt(phi)
+        if self.n > 1 and np.any(self.periodic):
+            r_2, r_1 = np.sort(reach)[-2:]
+            side = float(np.min(self.box[self.periodic]))
+            largest = min(largest, 0.45 * side / float(r_1 + r_2))
+        return largest
 
     def _initial_reaches(self, table):
         """Every disk's reach a_i float64[n] by the rule of the pair interaction

@@ -37,3 +37,10 @@ class InelasticCollapseError(PhysicsBreakdown):
             f"finite time; switch on the TC model (tc.time, far below the mean free time; the "
             f"crater scene uses 1e-8) so that contacts closer than t_c are elastic."
         )
+
+
+class GrowthLimitError(PhysicsBreakdown):
+    """Growing disks have reached the largest radii their box holds without jamming first
+    (a small periodic box: the nearest image of a pair is no longer the one that touches)."""
+
+    stop_reason = "growth_limit"

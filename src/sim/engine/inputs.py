@@ -329,17 +329,17 @@ def shaped_reals(call, name, value, shapes, accept, allowed):
     return array
 
 
-def check_stop(contacts, collisions, events, time, energy_fraction, wall_seconds, until,
-               chunk_events):
+def check_stop(contacts, collisions, events, time, energy_fraction, packing_fraction, jamming,
+               wall_seconds, until, chunk_events):
     """The arguments of :meth:`sim.engine.Engine.run`, checked as the command line checks its
     ``stop`` keys: counts whole from 0 to 2^62 (targets since the engine started), ``time``
-    finite and ≥ 0 (absolute), ``energy_fraction`` in [0, 1], ``wall_seconds`` finite and
-    ≥ 0 (0: spent), ``until`` callable, ``chunk_events`` whole from 1; at least one stop condition.
+    finite and ≥ 0 (absolute), ``energy_fraction`` in [0, 1], ``packing_fraction`` in (0, 1),
+    ``jamming`` a finite reduced pressure > 1, ``wall_seconds`` finite and ≥ 0 (0: spent),
+    ``until`` callable, ``chunk_events`` whole from 1; at least one stop condition.
     Returns them with the counts as ints and the numbers as floats (None kept)."""
     if all(x is None for x in (contacts, collisions, events, time, energy_fraction,
-                               wall_seconds, until)):
-        raise ValueError("run() needs at least one stop condition: contacts, collisions, "
-                         "events, time, energy_fraction, wall_seconds or until")
+                               packing_fraction, jamming, wall_seconds, until)):
+        raise ValueError("run() needs at least one stop condition: " + ", ".join(STOP_NAMES))
     counts = [None if value is None else whole_count("run", name, value) for name, value in
               (("contacts", contacts), ("collisions", collisions), ("events", events))]
     if time is not None:
@@ -349,19 +349,25 @@ def check_stop(contacts, collisions, events, time, energy_fraction, wall_seconds
         energy_fraction = real_number("run", "energy_fraction", energy_fraction,
                                       lambda f: 0.0 <= f <= 1.0,
                                       "a fraction of the initial kinetic energy in [0, 1]")
+    if packing_fraction is not None:
+        packing_fraction = real_number("run", "packing_fraction", packing_fraction,
+                                       lambda f: 0.0 < f < 1.0, "a packing fraction in (0, 1)")
+    if jamming is not None:
+        jamming = real_number("run", "jamming", jamming, lambda p: 1.0 < p < math.inf,
+                              "a finite reduced pressure βP/ρ > 1")
     if wall_seconds is not None:
         wall_seconds = real_number("run", "wall_seconds", wall_seconds,
                                    lambda w: 0.0 <= w < math.inf,
                                    "a finite number of seconds ≥ 0")
     if until is not None and not callable(until):
         raise refused("run", "until", until, "a function of the engine returning True to stop")
-    return (*counts, time, energy_fraction, wall_seconds, until,
+    return (*counts, time, energy_fraction, packing_fraction, jamming, wall_seconds, until,
             whole_count("run", "chunk_events", chunk_events, low=1))
 
 
 #: the stop conditions of :meth:`sim.engine.Engine.run`, in the order of its signature
-STOP_NAMES = ("contacts", "collisions", "events", "time", "energy_fraction", "wall_seconds",
-              "until")
+STOP_NAMES = ("contacts", "collisions", "events", "time", "energy_fraction", "packing_fraction",
+              "jamming", "wall_seconds", "until")
 
 
 def check_reachable(given, never):

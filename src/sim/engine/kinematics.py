@@ -250,3 +250,73 @@ def first_contact_oscillating(h, v, a, amplitude, omega, phase, tolerance, horiz
         if tau == INF:
             return INF, False
     return tau, False
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def growing_contact_time(rx, ry, vx, vy, sigma, sigma_rate, tau):
+    """Time until two growing disks touch: the first root of |r + v τ| = σ + ṡ τ, with
+    separation r = r_i − r_j, relative velocity v = v_i − v_j, contact distance σ now and its
+    rate of growth ṡ > 0 (Lubachevsky & Stillinger, J. Stat. Phys. 60, 561 (1990); Donev,
+    Torquato & Stillinger, J. Comput. Phys. 202, 737 (2005)); ∞ when there is none, or when
+    the filter shows that it comes no sooner than τ.
+
+    Squared, f(τ) = A τ² + 2 B τ + C = 0 with A = |v|² − ṡ², B = r·v − σ ṡ, C = |r|² − σ².
+    Unlike the hard core's, A may be ≤ 0 (disks slower than their growth always meet) and a
+    pair receding (r·v > 0) still meets when B < 0. The filter: on [0, τ] f is at least
+    C + 2 B τ' − ṡ² τ'², concave, so f > 0 there when C > 0 and C + (2 B − ṡ² τ) τ > 0.
+    The root, cancellation-free (Numerical Recipes §5.6) with D = B² − A C formed as
+    |v|² σ² − (r × v)² + ṡ (ṡ |r|² − 2 σ r·v) (no large |r|²|v|² taken from itself):
+      B < 0:          τ = C / (−B + √D), none when A > 0 and D ≤ 0 (a miss);
+      B ≥ 0, A < 0:   τ = (B + √D) / (−A), the later root (the pair first separates);
+      B ≥ 0, A ≥ 0:   none (f grows for ever).
+    A pair overlapping by round-off and closing (C < 0, B < 0) touches at once: τ = 0, never
+    in the past.
+    """
+    b0 = rx * vx + ry * vy
+    r_squared = rx * rx + ry * ry
+    c = r_squared - sigma * sigma
+    b = b0 - sigma * sigma_rate
+    if c > 0.0 and c + (2.0 * b - sigma_rate * sigma_rate * tau) * tau > 0.0:
+        return INF
+    v_squared = vx * vx + vy * vy
+    a = v_squared - sigma_rate * sigma_rate
+    cross = rx * vy - ry * vx
+    discriminant = (v_squared * sigma * sigma - cross * cross
+                    + sigma_rate * (sigma_rate * r_squared - 2.0 * sigma * b0))
+    root = math.sqrt(max(discriminant, 0.0))
+    if b < 0.0:
+        if a > 0.0 and discriminant <= 0.0:
+            return INF
+        return max(c / (root - b), 0.0)
+    if a < 0.0:
+        return (b + root) / -a
+    return INF
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def shrinking_shell_exit_time(dx, dy, vx, vy, delta, rate):
+    """Time until a disk at displacement ``d`` from its shell centre, moving with ``v``,
+    leaves a circle about that centre whose radius δ shrinks at ``rate`` ≥ 0 (a growing disk's
+    shell, :mod:`sim.effects.growth`): the first root of |d + v τ| = δ − rate τ.
+
+    Squared: A τ² + 2 B τ + C = 0 with A = |v|² − rate², B = d·v + δ rate, C = |d|² − δ² < 0
+    inside. The shrinking radius reaches zero at δ/rate, where |d + v τ| ≥ 0, so the first
+    root of the squared equation is the exit. B > 0: τ = −C/(B + √D); B ≤ 0 (then A > 0):
+    τ = (√D − B)/A (as :func:`shell_exit_time`, which this is at rate 0). A disk found outside
+    by round-off leaves at once (τ = 0); one whose speed and shrinking are both below
+    ``TINY_SPEED_SQUARED`` counts as at rest, never leaving.
+    """
+    v_squared = vx * vx + vy * vy
+    if v_squared + rate * rate < TINY_SPEED_SQUARED:
+        return INF
+    c = dx * dx + dy * dy - delta * delta
+    if c >= 0.0:
+        return 0.0
+    a = v_squared - rate * rate
+    b = dx * vx + dy * vy + delta * rate
+    s = math.sqrt(max(b * b - a * c, 0.0))
+    if b > 0.0:
+        return -c / (b + s)
+    if a > 0.0:
+        return (s - b) / a
+    return INF

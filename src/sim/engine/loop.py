@@ -38,12 +38,12 @@ import numpy as np
 from numba import njit
 
 from sim.effects.event_log import log_contact
-from sim.effects.gravity import shell_exit
+from sim.effects.growth import grown, growth_speed, shell_exit, wall_contact
 from sim.effects.restitution import collapsing, wall_restitution_of
 from sim.effects.rotation import rough_wall_contact
 from sim.effects.tc import tc_restitution
 from sim.effects.thermal_walls import contact_key
-from sim.effects.walls import hit_wall, predict_wall_contact
+from sim.effects.walls import hit_wall
 from sim.engine.box import PERIODIC, fold, image_velocity, separation
 from sim.engine.codes import (
     COLLISIONS,
@@ -131,14 +131,16 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
     vx = table[i, VX]
     vy = table[i, VY]
     r_i = table[i, RADIUS]
+    now = t_origin + t
     dx, dy = separation(box, x - table[i, CX], y - table[i, CY])
-    tau = shell_exit(gravity, dx, dy, vx, vy, per_disk(disks.delta, i))
+    tau = shell_exit(effects.growth, gravity, dx, dy, vx, vy, per_disk(disks.delta, i), r_i,
+                     optional_entry(neighbours.reach, i, r_i), now)
     partner = SHELL_EXIT
     for axis in range(2):
         if grid[PERIODIC + axis] == 0:
-            tau_w, side = predict_wall_contact(gravity, effects.wall_motion, axis, t_origin + t,
-                                               table[i, X + axis], table[i, VX + axis], r_i,
-                                               geometry, tau)
+            tau_w, side = wall_contact(effects.growth, gravity, effects.wall_motion, axis, now,
+                                       table[i, X + axis], table[i, VX + axis], r_i, geometry,
+                                       tau)
             if tau_w < tau:
                 tau = tau_w
                 # a search near a vibrating wall that stopped short: predict again from there
@@ -158,8 +160,10 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
         ux, uy = image_velocity(box, dy, ry)
         vx_ij = vx - vx_j - ux
         vy_ij = vy - vy_j - uy
+        sigma = r_i + table[j, RADIUS]
         tau_ij, event_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij,
-                                           r_i + table[j, RADIUS], tau,
+                                           grown(effects.growth, sigma, now),
+                                           growth_speed(effects.growth, sigma), tau,
                                            optional_entry(neighbours.pair_state, k, 0), disks)
         if tau_ij < tau and t + tau_ij <= event_time[j]:
             tau = tau_ij
@@ -192,9 +196,10 @@ def touch_wall(i, wall, t, t_origin, disks, box, effects, tallies, wall_contacts
                           t_last[i], t_last[i])
     key = contact_key(effects.wall_temperature, effects.seed, wall_contacts)
     m = per_disk(disks.mass, i)
+    r_i = disks.table[i, RADIUS]
     lost, impulse, work = hit_wall(i, wall, t_origin + t, xi_w, disks.table, m, box.geometry,
-                                   effects.wall_motion, effects.wall_temperature, key,
-                                   effects.gravity, effects.tc)
+                                   effects, key, grown(effects.growth, r_i, t_origin + t),
+                                   growth_speed(effects.growth, r_i))
     lost += rough_wall_contact(effects.roughness, effects, i, wall, impulse, t, disks, m)
     tallies.wall_impulse[wall] += impulse
     disks.stamp[i] += 1
@@ -360,8 +365,10 @@ def run_events(disks, schedule, neighbours, box, effects, pair, system, lookahea
             dissipated_disks += lost
             virial_sum += virial
         elif partner == SHELL_EXIT:
-            culprit = rebuild_neighbours(i, pair_reach(pair, i, disks), disks.table,
-                                         disks.delta, neighbours, box, lookahead is not None)
+            culprit = rebuild_neighbours(i, grown(effects.growth, pair_reach(pair, i, disks),
+                                                  t_origin + t),
+                                         disks.table, disks.delta, neighbours, box,
+                                         lookahead is not None)
             if culprit >= 0:
                 status = STATUS_LIST_FULL
                 break

@@ -7,6 +7,7 @@ import numpy as np
 
 from sim.effects.event_log import LOG_COLUMNS, LOG_DISK, LOG_PARTNER
 from sim.effects.gravity import potential_energy
+from sim.effects.growth import scale
 from sim.effects.rotation import moment_of_inertia, rotational_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
@@ -65,6 +66,22 @@ class Observables:
     def _state(self, t):
         return loop.state_at(self._relative_time(t), self.disks.table, self._box_group,
                              self.gravity)
+
+    def scale(self, t=None):
+        """R_i(t)/R_i(0) at absolute time ``t`` (default: the last event): 1 + γ t for
+        growing disks (:mod:`sim.effects.growth`), else 1."""
+        return scale(None if self.growth is None else self.growth.rate,
+                     self.time if t is None else float(t))
+
+    def radii(self, t=None):
+        """Radii float64[n] at absolute time ``t`` (default: the last event): ``radius``,
+        grown by :meth:`scale` for growing disks."""
+        return self.radius * self.scale(t)
+
+    def packing_fraction(self, t=None):
+        """The packing fraction Σ π R_i(t)² / A at absolute time ``t`` (default: the last
+        event)."""
+        return float(np.pi * np.sum(self.radii(t) ** 2) / np.prod(self.box))
 
     def positions(self, t=None):
         """Positions float64[n, 2] of every disk at absolute time ``t`` (default: the time of

@@ -56,13 +56,22 @@ from numba.core.errors import TypingError
 from numba.extending import overload
 
 from sim.effects.event_log import log_contact
+from sim.effects.growth import growth_speed
 from sim.effects.pressure_tensor import add_virial_tensor
 from sim.effects.restitution import collapsing, disk_restitution
 from sim.effects.rotation import rough_collision
 from sim.effects.tc import tc_restitution
 from sim.engine.box import separation
 from sim.engine.contact import collide_disks
-from sim.engine.kinematics import INF, RADIUS, X, Y, may_touch_before, pair_contact_time
+from sim.engine.kinematics import (
+    INF,
+    RADIUS,
+    X,
+    Y,
+    growing_contact_time,
+    may_touch_before,
+    pair_contact_time,
+)
 from sim.engine.neighbours import list_start
 from sim.engine.parameters import per_disk
 
@@ -123,21 +132,29 @@ def hard_core_time(rx, ry, vx, vy, sigma, tau):
     return INF
 
 
-def pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
+def pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, sigma_rate, tau, state, disks):
     """The next pair event of disks i and j as (time until it, event): the rule of ``pair``'s
-    kind (see the module docstring), or :func:`hard_core_time` and event 0."""
+    kind (see the module docstring), or the hard core's contact and event 0: at σ
+    (:func:`hard_core_time`) for disks that do not grow (``sigma_rate`` None), else at a
+    contact distance σ growing at ``sigma_rate``
+    (:func:`sim.engine.kinematics.growing_contact_time`, :mod:`sim.effects.growth`)."""
     if pair is None:
-        return hard_core_time(rx, ry, vx, vy, sigma, tau), 0
+        if sigma_rate is None:
+            return hard_core_time(rx, ry, vx, vy, sigma, tau), 0
+        return growing_contact_time(rx, ry, vx, vy, sigma, sigma_rate, tau), 0
     return RULES[type(pair)].event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks)
 
 
 @overload(pair_event_time, inline="always")
-def _pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
-    if pair is types.none:
-        return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks: (
+def _pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, sigma_rate, tau, state, disks):
+    if pair is types.none and sigma_rate is types.none:
+        return lambda pair, i, j, rx, ry, vx, vy, sigma, sigma_rate, tau, state, disks: (
             hard_core_time(rx, ry, vx, vy, sigma, tau), 0)
+    if pair is types.none:
+        return lambda pair, i, j, rx, ry, vx, vy, sigma, sigma_rate, tau, state, disks: (
+            growing_contact_time(rx, ry, vx, vy, sigma, sigma_rate, tau), 0)
     event_time = _rules_of(pair).event_time
-    return lambda pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks: event_time(
+    return lambda pair, i, j, rx, ry, vx, vy, sigma, sigma_rate, tau, state, disks: event_time(
         pair, i, j, rx, ry, vx, vy, sigma, tau, state, disks)
 
 
@@ -253,7 +270,8 @@ def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
                         t, t_last[i], t_last[j])
     m_i = per_disk(disks.mass, i)
     m_j = per_disk(disks.mass, j)
-    lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j)
+    lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j,
+                                 growth_speed(effects.growth, table[i, RADIUS] + table[j, RADIUS]))
     add_virial_tensor(effects.virial_tensor, rx, ry, virial)
     lost += rough_collision(effects.roughness, effects, i, j, rx, ry, virial, t, disks, m_i,
                             m_j)

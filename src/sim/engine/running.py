@@ -7,13 +7,19 @@ import time as wallclock
 
 import numpy as np
 
+from sim.effects.growth import time_of_scale
 from sim.effects.rotation import dissipates
 from sim.effects.walls import piston_jam
 from sim.engine import codes, loop
 from sim.engine.compilation import cacheable, compile_once
-from sim.engine.errors import ClosedBoxError, InelasticCollapseError, StalledError
+from sim.engine.errors import (
+    ClosedBoxError,
+    GrowthLimitError,
+    InelasticCollapseError,
+    StalledError,
+)
 from sim.engine.groups import Disks, Limits, Parts, Schedule, Tallies
-from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop
+from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop, refused
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
 from sim.engine.pairs import keeps
 
@@ -29,6 +35,19 @@ TIMED_MIN_CHUNK = 1_000
 #: The coldest a gas driven by thermal walls is taken to be, as a fraction of the walls'
 #: temperature, in :meth:`Running.latest_time` (an estimate with a wide margin).
 COLDEST_DRIVEN = 1e-6
+
+#: The reduced pressure βP/ρ at which a run stopped by a packing fraction takes growing disks
+#: for jammed (LS compressions stop at βP/ρ ≈ 10⁶ to 10¹²: Donev, Torquato & Stillinger,
+#: J. Comput. Phys. 202, 765 (2005)).
+JAMMING_PRESSURE = 1e6
+
+#: The jamming watch measures the reduced pressure over this many events per disk (and at
+#: most ``chunk_events``): near jamming the collision rate diverges, and the watch must see
+#: it before the clock reaches float64 resolution.
+JAMMING_WATCH_EVENTS = 20
+
+#: π/√12, the packing fraction of the hexagonal packing of disks of one size, the densest
+CLOSE_PACKING = math.pi / math.sqrt(12.0)
 
 #: Above this many disks :meth:`Running.disks_never_touch` tests no pairs (O(N²) in memory);
 #: scenes of disks that provably never meet are small hand-made ones.
@@ -101,7 +120,8 @@ class Running:
             return status
 
     def run(self, *, contacts=None, collisions=None, events=None, time=None,
-            energy_fraction=None, wall_seconds=None, until=None, chunk_events=200_000):
+            energy_fraction=None, packing_fraction=None, jamming=None, wall_seconds=None,
+            until=None, chunk_events=200_000):
         """Advance until the first stop condition holds; returns its name.
 
         contacts : disk–disk and disk–wall contacts since the start of the engine
@@ -109,6 +129,15 @@ class Running:
         events : events (contacts and neighbour-shell exits) since the start of the engine
         time : absolute simulated time; the run stops at the last event not after it
         energy_fraction : stop once the kinetic energy is this fraction of the initial one
+        packing_fraction : growing disks (:mod:`sim.effects.growth`): stop at the time their
+            packing fraction is this one, to round-off (:meth:`packing_fraction_time`; the
+            state is then read at that time: ``positions(t)``, ``radii(t)``); refused above
+            π/√12 for disks of one size. Watches for jamming too (at :data:`JAMMING_PRESSURE`
+            unless ``jamming`` is given): a mixture may jam first
+        jamming : stop once the reduced pressure βP/ρ = 1 + X/(2 K Δt) (X the collision
+            virial Σ r_ij·Δp_i over the last :data:`JAMMING_WATCH_EVENTS` events per disk
+            or ``chunk_events``, whichever is fewer, Δt their time, K the kinetic energy)
+            exceeds this
         wall_seconds : wall-clock budget of this call (compiling the loop not counted:
             :attr:`compile_seconds`), checked between chunks, which are then
             sized to take about :data:`TIMED_CHUNK_SECONDS` each (from the rate of the chunk
@@ -130,14 +159,15 @@ class Running:
         Chunk sizes change no result: the same inputs give the same bits.
         """
         given = {name: value for name, value in zip(STOP_NAMES, (
-            contacts, collisions, events, time, energy_fraction, wall_seconds, until),
-            strict=True) if value is not None}  # as written, for a refusal
-        (contacts, collisions, events, time, energy_fraction, wall_seconds, until,
-         chunk_events) = check_stop(contacts, collisions, events, time, energy_fraction,
-                                    wall_seconds, until, chunk_events)
+            contacts, collisions, events, time, energy_fraction, packing_fraction, jamming,
+            wall_seconds, until), strict=True) if value is not None}  # as written
+        (contacts, collisions, events, time, energy_fraction, packing_fraction, jamming,
+         wall_seconds, until, chunk_events) = check_stop(
+            contacts, collisions, events, time, energy_fraction, packing_fraction, jamming,
+            wall_seconds, until, chunk_events)
         self._refuse_unreachable(given, dict(zip(STOP_NAMES, (
-            contacts, collisions, events, time, energy_fraction, wall_seconds, until),
-            strict=True)))
+            contacts, collisions, events, time, energy_fraction, packing_fraction, jamming,
+            wall_seconds, until), strict=True)))
         big = np.iinfo(np.int64).max
         max_contacts = big if contacts is None else contacts
         max_events = big if events is None else events
@@ -145,6 +175,16 @@ class Running:
         t_stop = math.inf if time is None else time
         closing = t_stop > self.closing_time
         t_stop = min(t_stop, self.closing_time)
+        t_packed = math.inf
+        if packing_fraction is not None:
+            t_packed = self.packing_fraction_time(packing_fraction)
+            jamming = JAMMING_PRESSURE if jamming is None else jamming
+            if t_packed <= self.time:
+                return "packing_fraction"
+        grown_out = self.growth is not None and self.growth_end < min(t_stop, t_packed)
+        packs = t_packed <= t_stop and t_packed <= self.growth_end
+        t_stop = min(t_stop, t_packed, self.growth_end)
+        pressure_from = (self.time, self.virial)
         dissipation_limit = (math.inf if energy_fraction is None
                              else self.initial_energy * (1.0 - energy_fraction))
         started, compiled_before = wallclock.perf_counter(), self.compile_seconds
@@ -153,7 +193,11 @@ class Running:
                    codes.STATUS_ENERGY_REACHED: "energy_fraction",
                    codes.STATUS_NO_EVENTS: "no_events"}
         chunk = chunk_events if wall_seconds is None else min(chunk_events, TIMED_FIRST_CHUNK)
-        ask_at = self.events + chunk_events  # where ``until`` is asked next
+        # where ``until`` (and the jamming watch, every JAMMING_WATCH_EVENTS per disk) is
+        # asked next
+        ask_every = (chunk_events if jamming is None
+                     else min(chunk_events, JAMMING_WATCH_EVENTS * self.n))
+        ask_at = self.events + ask_every
         while True:
             chunk_started = wallclock.perf_counter()
             done = self.events
@@ -163,6 +207,14 @@ class Running:
             if status == codes.STATUS_EVENT_LIMIT and self.events >= max_events:
                 return "events"
             if status != codes.STATUS_EVENT_LIMIT:
+                if packs and status == codes.STATUS_TIME_REACHED:
+                    return "packing_fraction"
+                if grown_out and status == codes.STATUS_TIME_REACHED:
+                    raise GrowthLimitError(
+                        f"at t = {self.growth_end:.6g} the growing disks reach the largest "
+                        f"radii their box holds ({self.largest_scale:.6g} times the initial "
+                        f"ones, packing fraction {self.packing_fraction(self.growth_end):.6g}) "
+                        f"without jamming: use a larger box (more disks) or stop earlier")
                 if closing and status == codes.STATUS_TIME_REACHED:
                     raise ClosedBoxError(
                         f"at t = {self.closing_time:.6g} the moving walls come within the "
@@ -176,9 +228,44 @@ class Running:
                 rate = (self.events - done) / max(now - chunk_started, 1e-6)
                 chunk = int(np.clip(rate * TIMED_CHUNK_SECONDS, TIMED_MIN_CHUNK, chunk_events))
             if self.events >= ask_at:
-                ask_at += chunk_events
+                ask_at += ask_every
+                if jamming is not None:
+                    pressure = self.reduced_pressure(*pressure_from)
+                    pressure_from = (self.time, self.virial)
+                    if pressure > jamming:
+                        return "jamming"
                 if until is not None and until(self):
                     return "predicate"
+
+    @property
+    def growth_end(self):
+        """The absolute time at which growing disks reach the largest radii their box holds
+        (``largest_scale``); inf for disks that do not grow."""
+        return (math.inf if self.growth is None
+                else time_of_scale(self.growth.rate, self.largest_scale))
+
+    def packing_fraction_time(self, target):
+        """The absolute time at which growing disks fill the packing fraction ``target``:
+        φ(t) = φ(0)(1 + γ t)². A ValueError for disks that do not grow, and for a target
+        above π/√12 (the densest packing) when all disks have one size."""
+        if len(set(self.radius.tolist())) == 1 and target > CLOSE_PACKING:
+            raise refused("run", "packing_fraction", target, f"at most π/√12 = "
+                          f"{CLOSE_PACKING:.6g}, the densest packing of disks of one size")
+        if self.growth is None:
+            raise refused("run", "packing_fraction", target, f"{self.packing_fraction():.6g} "
+                          f"(the disks' own) or below: these disks do not grow (growth_rate)")
+        return time_of_scale(self.growth.rate, math.sqrt(target / self.packing_fraction(0.0)))
+
+    def reduced_pressure(self, since_time, since_virial):
+        """βP/ρ = 1 + X / (2 K Δt) from the collision virial X = Σ r_ij·Δp_i since the
+        absolute time ``since_time`` (when the virial was ``since_virial``), Δt the time since
+        and K the kinetic energy now (K = N kT in two dimensions; growth's rescaling keeps it
+        at its initial value); inf when no time has passed."""
+        elapsed = self.time - since_time
+        kinetic = self.kinetic_energy()
+        if elapsed <= 0.0 or kinetic <= 0.0:
+            return math.inf
+        return 1.0 + (self.virial - since_virial) / (2.0 * kinetic * elapsed)
 
     def _refuse_unreachable(self, given, checked):
         """:func:`check_reachable` for the stop conditions ``given`` to :meth:`run` (name →

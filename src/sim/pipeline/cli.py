@@ -149,10 +149,13 @@ def _job(cfg, sweeping, output_dir):
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
     info = summary(path, verify=False)  # the file was just written: no pass over it
+    balance = ("no balance: the disks grow" if info["growth_rate"] > 0.0
+               else "no balance: no snapshot has every energy" if info["energy_drift"] is None
+               else f"balance error {info['energy_drift']:.1e}")
     print(f"{info['scene']}: {info['n']} disks, {info['collisions']} collisions to t = "
           f"{info['time_span'][1]:.6g}, {info['snapshots']} snapshots, energy "
-          f"{info['final_energy']:.6g} (dissipated {info['dissipated_energy']:.3g}, balance "
-          f"error {info['energy_drift']:.1e}), stop reason: {info['stop_reason']}\n"
+          f"{info['final_energy']:.6g} (dissipated {info['dissipated_energy']:.3g}, "
+          f"{balance}), stop reason: {info['stop_reason']}\n"
           f"run file: {path}", flush=True)
     if info["stop_reason"] in ("interrupted", "terminated"):
         if sweeping:

@@ -10,6 +10,7 @@ checks of each scene's own keys, are :data:`sim.pipeline.scenes.SCENES`.
 """
 
 import math
+from dataclasses import fields
 from typing import Any
 
 from hydra.core.config_store import ConfigStore
@@ -30,7 +31,10 @@ from sim.engine.inputs import MAX_COUNT
 from sim.pipeline.config_reference import leaves
 from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.scenes import SCENES
-from sim.pipeline.schema import SimConfig, leaf_fields, plain_type
+from sim.pipeline.schema import SimConfig, StopConfig, leaf_fields, plain_type
+
+#: the stop conditions of a scene (``stop:``), in the order of conf/config.yaml
+STOP_KEYS = tuple(f.name for f in fields(StopConfig))
 
 
 def register():
@@ -146,10 +150,18 @@ def validate(cfg: Any) -> None:
     within("stop.energy_fraction", s.energy_fraction, 0.0, 1.0, "between 0 and 1")
     if s.at_rest is not None and not 0.0 < s.at_rest <= 1.0:
         raise ConfigError("stop.at_rest", s.at_rest, "a fraction in (0, 1]")
-    if all(s[k] is None for k in ("collisions", "contacts", "time", "energy_fraction",
-                                  "at_rest", "wall_seconds")):
-        raise ConfigError("stop", None, "at least one of stop.collisions, stop.contacts, "
-                          "stop.time, stop.energy_fraction, stop.at_rest, stop.wall_seconds")
+    if s.packing_fraction is not None and not 0.0 < s.packing_fraction < 1.0:
+        raise ConfigError("stop.packing_fraction", s.packing_fraction,
+                          "a packing fraction in (0, 1) (with growth.rate > 0)")
+    if s.packing_fraction is not None and c.growth.rate == 0.0:
+        raise ConfigError("stop.packing_fraction", s.packing_fraction,
+                          "null with growth.rate = 0: disks that do not grow keep their "
+                          "packing fraction (set growth.rate > 0)")
+    if s.jamming is not None and not 1.0 < s.jamming < math.inf:
+        raise ConfigError("stop.jamming", s.jamming, "a finite reduced pressure βP/ρ > 1")
+    if all(s[k] is None for k in STOP_KEYS):
+        raise ConfigError("stop", None, "at least one of "
+                          + ", ".join(f"stop.{k}" for k in STOP_KEYS))
     o = c.output
     if not o.file or "/" in o.file or o.file.startswith(".") or not o.file.strip():
         raise ConfigError("output.file", o.file, "a file name in the run folder, such as "

@@ -31,7 +31,8 @@ from sim.storage.inspect import open_run_file
 log = logging.getLogger(__name__)
 
 #: Stop reasons of a run that ended as configured (a resumed run with these has nothing to do).
-FINISHED = ("collisions", "contacts", "time", "energy_fraction", "at_rest", "no_events")
+FINISHED = ("collisions", "contacts", "time", "energy_fraction", "packing_fraction", "jamming",
+            "at_rest", "no_events")
 
 #: The stop key that sim 0.1.0 renamed (stop.contacts now) and still stored, always null:
 #: dropped from the configs of its run files, refused when set (a run file of an older sim)
@@ -39,7 +40,8 @@ RENAMED_STOP = "events"
 
 #: Keys a resume may change: when the run stops, how often it writes, what it shows.
 RESUMABLE = ("stop.collisions", "stop.contacts", "stop.time",
-             "stop.energy_fraction", "stop.at_rest", "stop.wall_seconds",
+             "stop.energy_fraction", "stop.packing_fraction", "stop.jamming", "stop.at_rest",
+             "stop.wall_seconds",
              "output.every_collisions", "output.every_time", "output.progress")
 
 #: Keys in which a run asked for again into its own folder may differ from the run there:

@@ -213,6 +213,57 @@ def mixture(cfg):
     return base
 
 
+def _check_compress(c):
+    """A radius ratio of at least 1, a fraction of large disks in [0, 1], a growth rate, and
+    a placement at random (the scene starts from a random dilute gas)."""
+    k = c.compress
+    if not 1.0 <= k.radius_ratio <= 100.0:
+        raise ConfigError("compress.radius_ratio", k.radius_ratio,
+                          "a ratio of large to small radius from 1 to 100")
+    within("compress.large_fraction", k.large_fraction, 0.0, 1.0, "a number fraction in [0, 1]")
+    if c.growth.rate <= 0.0:
+        raise ConfigError("growth.rate", c.growth.rate, "a rate > 0: the compress scene grows "
+                          "its disks")
+    if c.disks.placement not in ("random", "auto"):
+        raise ConfigError("disks.placement", c.disks.placement,
+                          "random or auto: the compress scene starts from a random gas")
+
+
+def _compress_radii(cfg):
+    """Radii float64[n] and species int32[n] of the compress scene: a fraction
+    ``compress.large_fraction`` of large disks (species 1, ``compress.radius_ratio`` times
+    the small radius), shuffled by the seed, the small radius set by the packing fraction."""
+    d, k = cfg.disks, cfg.compress
+    n = int(d.n)
+    large = round(float(k.large_fraction) * n)
+    species = np.random.default_rng(cfg.seed + 2).permutation(
+        np.repeat(np.array([0, 1], np.int32), [n - large, large]))
+    relative = np.where(species == 1, float(k.radius_ratio), 1.0)
+    if d.radius is not None:
+        return float(d.radius) * relative, species
+    area = float(cfg.box.size[0]) * float(cfg.box.size[1])
+    return relative * math.sqrt(float(d.packing_fraction) * area
+                                / (math.pi * float(np.sum(relative**2)))), species
+
+
+def _compress_preparation(cfg):
+    return f"random sequential addition; {_gas_preparation(cfg).split('; ', 1)[1]}"
+
+
+def compress(cfg):
+    """A random dilute gas of two sizes, which the scene's growth compresses."""
+    radius, species = _compress_radii(cfg)
+    mass = np.full(radius.size, float(cfg.disks.mass))
+    box = (float(cfg.box.size[0]), float(cfg.box.size[1]))
+    try:
+        position = random_sequential(radius, box=box, periodic=_boundary(cfg).periodic,
+                                     seed=cfg.seed)
+    except PlacementError as error:
+        raise ConfigError("disks.packing_fraction", cfg.disks.packing_fraction,
+                          error.reason) from error
+    return Scene(position, _velocities(cfg, mass), radius, mass, species, _boundary(cfg))
+
+
 def single_disk(cfg):
     radius = _gas_radius(cfg)
     ly = float(cfg.box.size[1])
@@ -421,6 +472,8 @@ SCENES = {spec.name: spec for spec in (
     SceneSpec("gas", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("mixture", mixture, given_count, preparation=_gas_preparation,
               sections=("mixture",), check=_check_mixture, gas_like=True),
+    SceneSpec("compress", compress, given_count, preparation=_compress_preparation,
+              sections=("compress",), check=_check_compress, gas_like=True),
     SceneSpec("crater", crater, _crater_count, preparation=_crater_preparation,
               sections=("projectile", "bed"), check=_check_crater, packing_fraction=_bed_packing),
     SceneSpec("cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),

@@ -72,11 +72,19 @@ class TCConfig:
 
 
 @dataclass
+class GrowthConfig:
+    rate: float = 0.0
+    rescale_every: float = 1.0
+
+
+@dataclass
 class StopConfig:
     collisions: Optional[int] = None
     contacts: Optional[int] = None
     time: Optional[float] = None
     energy_fraction: Optional[float] = None
+    packing_fraction: Optional[float] = None
+    jamming: Optional[float] = None
     at_rest: Optional[float] = None
     wall_seconds: Optional[float] = None
 
@@ -114,6 +122,7 @@ class ObserveConfig:
     mean_squared_displacement: bool = False
     velocity_autocorrelation: bool = False
     pressure_tensor: bool = False
+    bond_order: bool = False
     event_log: bool = False
 
 
@@ -141,6 +150,12 @@ class MixtureConfig:
 
 
 @dataclass
+class CompressConfig:
+    radius_ratio: float = 1.4
+    large_fraction: float = 0.5
+
+
+@dataclass
 class ScatteringConfig:
     impact_parameter: float = 0.0
     target_radius: float = 0.1
@@ -164,12 +179,14 @@ class SimConfig:
     friction: FrictionConfig = field(default_factory=FrictionConfig)
     gravity: list = field(default_factory=lambda: [0.0, 0.0])
     walls: WallsConfig = field(default_factory=WallsConfig)
+    growth: GrowthConfig = field(default_factory=GrowthConfig)
     stop: StopConfig = field(default_factory=StopConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
     observe: ObserveConfig = field(default_factory=ObserveConfig)
     projectile: Optional[ProjectileConfig] = None
     bed: Optional[BedConfig] = None
     mixture: Optional[MixtureConfig] = None
+    compress: Optional[CompressConfig] = None
     scattering: Optional[ScatteringConfig] = None
     two_disks: Optional[TwoDisksConfig] = None
     resume: Optional[str] = None

@@ -78,13 +78,16 @@ def advance(engine, cfg, writer, last_time, started, interruption):
             reason = engine.run(
                 contacts=stop.contacts, collisions=None if collisions == math.inf else collisions,
                 time=None if t_stop == math.inf else t_stop,
-                energy_fraction=stop.energy_fraction, wall_seconds=budget(), until=until)
-            snapshot_time = t_stop if reason == "time" else None
+                energy_fraction=stop.energy_fraction, packing_fraction=stop.packing_fraction,
+                jamming=stop.jamming, wall_seconds=budget(), until=until)
+            snapshot_time = {"time": t_stop, "packing_fraction": engine.packing_fraction_time(
+                stop.packing_fraction) if reason == "packing_fraction" else None}.get(reason)
             last_time = engine.time if snapshot_time is None else snapshot_time
             met = {"collisions": stop.collisions is not None
                    and engine.collisions >= stop.collisions,
                    "time": stop.time is not None and last_time >= stop.time,
-                   "contacts": True, "energy_fraction": True}.get(reason, False)
+                   "contacts": True, "energy_fraction": True, "packing_fraction": True,
+                   "jamming": True}.get(reason, False)
             if reason in ("time", "no_events") and math.isinf(engine.next_event_time()):
                 # nothing will ever move again: the run is over
                 reason, met = "no_events", True

@@ -15,7 +15,7 @@ where that is bounded: a kinetic energy that never changes, or gravity
 
 import numpy as np
 
-from sim.pipeline.config import ConfigError
+from sim.pipeline.config import STOP_KEYS, ConfigError
 
 
 def at_rest(fraction):
@@ -47,6 +47,10 @@ def already_met(engine, cfg):
         left = 1.0 - engine.dissipated_energy / engine.initial_energy
         return ("stop.energy_fraction", s.energy_fraction,
                 f"below the fraction {left:.6g} of the initial energy the run has left")
+    if s.packing_fraction is not None and engine.packing_fraction() >= s.packing_fraction:
+        return ("stop.packing_fraction", s.packing_fraction,
+                f"above the packing fraction {engine.packing_fraction():.6g} the run has "
+                f"reached already")
     if s.at_rest is not None and at_rest(s.at_rest)(engine):
         return ("stop.at_rest", s.at_rest, "a fraction the run has not reached yet")
     return None
@@ -60,8 +64,7 @@ def check_reachable(cfg, engine):
     s = cfg.stop
     if engine.still:
         return  # nothing moves: the run ends at once with no events left
-    given = {key: s[key] for key in ("collisions", "contacts", "time", "energy_fraction",
-                                     "wall_seconds", "at_rest") if s[key] is not None}
+    given = {key: s[key] for key in STOP_KEYS if s[key] is not None}
     why = {}
     for key, value in given.items():
         if key != "at_rest":

@@ -110,11 +110,13 @@ def frame_indices(spec, count):
 
 
 def snapshots(run, indices):
-    """(step, time, position, velocity, spin) of the snapshots ``indices`` of the open run
-    ``run`` (:func:`sim.analysis.datasets.open_run`), read one at a time; positions and velocities
-    float64[n, 2], spins ω float64[n] (None when the disks do not turn). :class:`BadInput` at
-    a damaged snapshot."""
+    """(step, time, position, velocity, spin, radius) of the snapshots ``indices`` of the
+    open run ``run`` (:func:`sim.analysis.datasets.open_run`), read one at a time; positions
+    and velocities float64[n, 2], spins ω float64[n] (None when the disks do not turn), radii
+    float64[n] (grown to the snapshot's time for growing disks, ``radius_scale``).
+    :class:`BadInput` at a damaged snapshot."""
     steps, times = run["step"].values, run["time"].values
+    scales = run["radius_scale"].values if "radius_scale" in run else np.ones(times.size)
     for i in indices:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # a damaged frame reads as NaN
@@ -127,7 +129,7 @@ def snapshots(run, indices):
                 and np.isfinite(step) and np.isfinite(time)):
             raise BadInput(f"{run.attrs['path']}: snapshot {i} is damaged (sim-inspect names "
                               f"what); leave it out with --frames")
-        yield int(step), float(time), position, velocity, spin
+        yield int(step), float(time), position, velocity, spin, run["radius"].values * scales[i]
 
 
 def moments_of_inertia(run):
@@ -185,10 +187,9 @@ def write_gsd(path, run, frames):
     mass = run["mass"].values
     types = [_type_name(s) for s in range(run.sizes["species"])]
     typeid = run["species_id"].values.astype(np.uint32)
-    diameter = (2.0 * run["radius"].values).astype(np.float32)
     inertia = moments_of_inertia(run)
     with gsd.hoomd.open(path, "w") as trajectory:
-        for step, time, position, velocity, spin in frames:
+        for step, time, position, velocity, spin, radius in frames:
             frame = gsd.hoomd.Frame()
             frame.configuration.step = step
             frame.configuration.dimensions = 2
@@ -196,7 +197,7 @@ def write_gsd(path, run, frames):
             frame.particles.N = position.shape[0]
             frame.particles.types = types
             frame.particles.typeid = typeid
-            frame.particles.diameter = diameter
+            frame.particles.diameter = (2.0 * radius).astype(np.float32)
             frame.particles.mass = mass.astype(np.float32)
             frame.particles.position = hoomd_positions(position, box, periodic)
             frame.particles.velocity = np.zeros((mass.size, 3), np.float32)
@@ -217,15 +218,14 @@ def write_xyz(path, run, frames):
     file ``path``; spins ω as a last column ``spin``."""
     lx, ly = run.attrs["box"]
     pbc = " ".join("T" if b == "periodic" else "F" for b in run.attrs["boundary"])
-    radius = run["radius"].values
-    slab = 2.0 * float(radius.max())
-    cell = f'Lattice="{lx!r} 0 0 0 {ly!r} 0 0 0 {slab!r}" Origin="0 0 {-0.5 * slab!r}"'
     species = run["species_id"].values.tolist()
-    size_and_mass = [f"{r!r} {m!r}" for r, m in zip(radius.tolist(),
-                                                     run["mass"].values.tolist(), strict=True)]
+    mass = run["mass"].values.tolist()
     properties = XYZ_PROPERTIES + (f":{XYZ_SPIN}" if "angular_velocity" in run else "")
     with open(path, "w") as out:
-        for step, time, position, velocity, spin in frames:
+        for step, time, position, velocity, spin, radius in frames:
+            slab = 2.0 * float(radius.max())
+            cell = f'Lattice="{lx!r} 0 0 0 {ly!r} 0 0 0 {slab!r}" Origin="0 0 {-0.5 * slab!r}"'
+            size_and_mass = [f"{r!r} {m!r}" for r, m in zip(radius.tolist(), mass, strict=True)]
             out.write(f"{len(species)}\n{cell} Properties={properties} Time={time!r} "
                       f"Step={step} pbc=\"{pbc} F\"\n")
             ends = ["\n"] * len(species) if spin is None else [f" {w!r}\n" for w in spin.tolist()]

@@ -7,7 +7,9 @@ Layout written by :class:`RunWriter`:
   /particles/disks/velocity   the same layout
   /particles/disks/angular_velocity   when the disks turn (:mod:`sim.effects.rotation`):
                               spins ω, value float64[T, N]
-  /particles/disks/radius, mass, species   time-independent, [N]
+  /particles/disks/radius, mass, species   time-independent, [N]; growing disks
+                              (:mod:`sim.effects.growth`): their radii at time 0, and
+                              /observables/radius_scale R_i(t)/R_i(0)
   /observables/<name>         step, time, value — kinetic_energy, kinetic_energy_by_species
                               [T, S], collisions, wall_contacts, dissipated_energy,
                               collision_virial, rotational_energy (when the disks turn);
@@ -64,6 +66,10 @@ OBSERVABLES = {
 
 #: time series of /particles/disks (angular_velocity: when the disks turn)
 PARTICLE_SERIES = ("position", "velocity", "angular_velocity")
+
+#: observables of a run whose disks grow (:mod:`sim.effects.growth`)
+GROWTH_OBSERVABLES = {"radius_scale": ("1", "R_i(t)/R_i(0) = 1 + γ t of growing disks, whose "
+                                            "radii at time 0 are /particles/disks/radius")}
 
 #: observables that count (int64)
 COUNTS = ("collisions", "wall_contacts")
@@ -194,8 +200,9 @@ class RunWriter:
                                    ("species", engine.species, "1")):
             disks.create_dataset(name, data=values, fletcher32=True).attrs["unit"] = unit
         observables = f.create_group("observables")
-        for name, (unit, description) in (OBSERVABLES | (SPIN_OBSERVABLES if engine.spinning
-                                                         else {})).items():
+        for name, (unit, description) in (
+                OBSERVABLES | (SPIN_OBSERVABLES if engine.spinning else {})
+                | (GROWTH_OBSERVABLES if engine.growth is not None else {})).items():
             shape = (engine.n_species,) if name.endswith("by_species") else ()
             dtype = np.int64 if name in COUNTS else np.float64
             _time_series(observables.create_group(name), shape, dtype, unit, description)
@@ -242,6 +249,8 @@ class RunWriter:
         if engine.spinning:
             particles["angular_velocity"] = engine.angular_velocities()
             observables["rotational_energy"] = engine.rotational_energy()
+        if engine.growth is not None:
+            observables["radius_scale"] = engine.scale(t)
         for observer in self.observers:
             observables[observer.name] = observer(engine, t, position, velocity)
         self._frames.append((engine.contacts, t, particles, observables))

@@ -279,7 +279,10 @@ def summary(path, verify=True):
     # the drift is measured, over the intact snapshots, against the largest energy seen
     balance = energy + potential + dissipated - work
     intact = ~np.isnan(balance)
-    if intact.any():
+    result["growth_rate"] = float((config.get("growth") or {}).get("rate", 0.0))
+    if result["growth_rate"] > 0.0:
+        result["energy_drift"] = None  # growing disks: growth pumps energy in, rescaling out
+    elif intact.any():
         balance = balance[intact] - balance[intact][0]
         scale = max(np.max(energy[intact]), np.max(np.abs(work[intact])),
                     np.max(dissipated[intact]), np.finfo(float).tiny)

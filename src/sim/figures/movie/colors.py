@@ -124,7 +124,7 @@ def cluster_rule(snapshots, radius):
     :class:`sim.analysis.observers.Clusters`, with the run's gap if it set one."""
     gap = ((snapshots.config.get("observe") or {}).get("clusters") or {}).get("gap")
     disks = SimpleNamespace(radius=radius, n=radius.size, box=snapshots.box,
-                            periodic=snapshots.periodic)
+                            periodic=snapshots.periodic, radii=lambda t: radius)
     observer = Clusters(DEFAULT_CLUSTER_GAP if gap is None else float(gap), disks)
     return lambda position: observer(disks, None, position, None)
 

@@ -1,0 +1,127 @@
+"""The structure of a packing: its contact network and rattlers, and the bond-orientational
+order ψ₆ of its disks.
+
+Contacts: disks i and j touch when their gap |r_ij| − (R_i + R_j) is below ``tolerance``
+times the mean diameter 2⟨R⟩. A jammed packing from an LS compression stopped at a reduced
+pressure βP/ρ ≈ 10⁶ has its contacts at gaps of about 10⁻⁶ σ and the next neighbours at
+gaps of order 10⁻² σ, so the count is flat (a plateau) for tolerances between the two
+(:func:`contact_numbers` sweeps them). Rattlers are disks held by fewer than three contacts
+(d + 1 in d = 2 dimensions: no frictionless disk is stable with fewer); removing one takes
+its contacts away from its neighbours, so they are removed recursively (O'Hern, Silbert, Liu
+& Nagel, PRE 68, 011306 (2003)). The backbone's mean contact number z is 4 = 2d at the
+isostatic point of frictionless disks, less a correction of order 1/N for a finite packing.
+
+Bond order: ψ₆(i) = (1/n_i) Σ_j exp(6 i θ_ij) over the n_i Voronoi neighbours j of disk i
+(θ_ij the angle of r_j − r_i, through the nearest periodic image; the neighbours are the
+edges of the Delaunay triangulation of the centres, periodic images of the disks near the
+edges included), and the global order |Ψ₆| = |(1/N) Σ_i ψ₆(i)|: 1 for a hexagonal crystal,
+of order 1/√N for a fluid (Nelson & Halperin, PRB 19, 2457 (1979); Bernard & Krauth, PRL 107,
+155704 (2011)). freud's ``Hexatic`` with its ``Voronoi`` neighbours is the test's oracle.
+
+Positions float64[n, 2] in the box [0, L_x] × [0, L_y], radii float64[n].
+"""
+
+import numpy as np
+from scipy.spatial import Delaunay
+
+from sim.checks.audit import kd_tree
+from sim.engine.box import folded, nearest_images
+
+#: tolerances of :func:`contact_numbers`, in units of the mean diameter: from below the
+#: contacts' gaps of an LS packing at βP/ρ ≈ 10⁶ to above them
+CONTACT_TOLERANCES = np.logspace(-9, -1, 17)
+
+#: the contacts a frictionless disk needs to be held, d + 1 in two dimensions
+HELD = 3
+
+
+def contacts(position, radius, box, periodic, tolerance):
+    """The pairs (i, j), i < j, int64[k, 2], whose gap is below ``tolerance`` × 2⟨R⟩."""
+    position = folded(np.asarray(position, np.float64), box, periodic)
+    radius = np.asarray(radius, np.float64)
+    slack = tolerance * 2.0 * float(np.mean(radius))
+    tree = kd_tree(position, box, periodic)
+    pairs = tree.query_pairs(2.0 * float(radius.max()) + slack, output_type="ndarray")
+    if pairs.size == 0:
+        return np.zeros((0, 2), np.int64)
+    r = nearest_images(position[pairs[:, 0]] - position[pairs[:, 1]], box, periodic)
+    gap = np.hypot(r[:, 0], r[:, 1]) - radius[pairs[:, 0]] - radius[pairs[:, 1]]
+    return pairs[gap < slack].astype(np.int64)
+
+
+def backbone(pairs, n):
+    """Whether each of the ``n`` disks is in the backbone bool[n]: rattlers, disks with fewer
+    than :data:`HELD` contacts among ``pairs``, removed until none is left."""
+    kept = np.ones(n, bool)
+    while True:
+        live = pairs[kept[pairs[:, 0]] & kept[pairs[:, 1]]]
+        count = np.bincount(live.ravel(), minlength=n)
+        loose = kept & (count < HELD)
+        if not loose.any():
+            return kept
+        kept &= ~loose
+
+
+def contact_number(position, radius, box, periodic, tolerance):
+    """(z, rattler fraction, backbone contacts) of a packing at one tolerance: z = 2 C / N_b,
+    with C the contacts among the N_b backbone disks (:func:`backbone`); z = 0 with no
+    backbone."""
+    n = len(radius)
+    pairs = contacts(position, radius, box, periodic, tolerance)
+    kept = backbone(pairs, n)
+    live = pairs[kept[pairs[:, 0]] & kept[pairs[:, 1]]]
+    held = int(kept.sum())
+    return (2.0 * len(live) / held if held else 0.0), 1.0 - held / n, len(live)
+
+
+def contact_numbers(position, radius, box, periodic, tolerances=CONTACT_TOLERANCES):
+    """:func:`contact_number` at every tolerance: float64 arrays (z, rattler fraction) over
+    ``tolerances``, whose plateau is the packing's."""
+    rows = [contact_number(position, radius, box, periodic, t)[:2] for t in tolerances]
+    z, rattlers = np.array(rows).T
+    return z, rattlers
+
+
+def voronoi_neighbours(position, box, periodic):
+    """The Voronoi neighbour pairs (i, j), i < j, int64[k, 2]: the edges of the Delaunay
+    triangulation of the centres, with the periodic images of the disks within a margin
+    of the edges (four mean spacings) on periodic axes."""
+    position = folded(np.asarray(position, np.float64), box, periodic)
+    n = position.shape[0]
+    box = np.asarray(box, np.float64)
+    margin = 4.0 * np.sqrt(np.prod(box) / n)
+    points, owner = [position], [np.arange(n)]
+    shifts = [(sx, sy) for sx in (-1, 0, 1) for sy in (-1, 0, 1) if (sx, sy) != (0, 0)
+              and (periodic[0] or sx == 0) and (periodic[1] or sy == 0)]
+    for sx, sy in shifts:
+        moved = position + np.array([sx, sy]) * box
+        near = np.all((moved > -margin) & (moved < box + margin), axis=1)
+        points.append(moved[near])
+        owner.append(np.flatnonzero(near))
+    points, owner = np.vstack(points), np.concatenate(owner)
+    triangles = Delaunay(points).simplices
+    edges = np.vstack([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    edges = edges[(edges < n).any(axis=1)]  # an edge of an original disk
+    edges = np.sort(owner[edges], axis=1)
+    edges = edges[edges[:, 0] != edges[:, 1]]
+    return np.unique(edges, axis=0)
+
+
+def bond_order(position, box, periodic):
+    """ψ₆ of every disk, complex128[n], over its Voronoi neighbours
+    (:func:`voronoi_neighbours`); see the module docstring."""
+    position = folded(np.asarray(position, np.float64), box, periodic)
+    n = position.shape[0]
+    pairs = voronoi_neighbours(position, box, periodic)
+    r = nearest_images(position[pairs[:, 1]] - position[pairs[:, 0]], box, periodic)
+    bond = np.exp(6j * np.arctan2(r[:, 1], r[:, 0]))  # the bond j → i is the same (6 × π)
+    total = np.zeros(n, complex)
+    np.add.at(total, pairs[:, 0], bond)
+    np.add.at(total, pairs[:, 1], bond)
+    count = np.bincount(pairs.ravel(), minlength=n)
+    return np.divide(total, count, out=np.zeros(n, complex), where=count > 0)
+
+
+def global_bond_order(position, box, periodic):
+    """|Ψ₆| = |⟨ψ₆⟩| over all disks (:func:`bond_order`)."""
+    return float(abs(bond_order(position, box, periodic).mean()))
