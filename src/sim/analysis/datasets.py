@@ -35,6 +35,7 @@ from xarray.core import indexing
 from sim.analysis.cells import cell_index, granular_temperature, grid
 from sim.storage.errors import RunFileError
 from sim.storage.h5md import (
+    GROWTH_OBSERVABLES,
     OBSERVABLES,
     PARTICLE_SERIES,
     SPIN_OBSERVABLES,
@@ -127,7 +128,7 @@ def open_run(path):
         for name, group in f["observables"].items():
             if name.endswith("by_species"):
                 dims = ("time", "species")
-            elif name in OBSERVABLES or name in SPIN_OBSERVABLES:
+            elif name in OBSERVABLES or name in SPIN_OBSERVABLES or name in GROWTH_OBSERVABLES:
                 dims = ("time",)
             else:  # an observer's: its dims as an attribute, coordinates beside its value
                 dims = ("time", *(str(d) for d in group.attrs["dims"]))
@@ -309,7 +310,7 @@ def global_bond_order(run):
     """|Ψ₆| = |⟨ψ₆⟩| over the disks at every snapshot of a run that observed ψ₆
     (``observe.bond_order=true``, :class:`sim.analysis.observers.BondOrder`): a DataArray
     over time."""
-    psi = run["bond_order"].sel(part=b"re") + 1j * run["bond_order"].sel(part=b"im")
+    psi = run["bond_order"].isel(part=0) + 1j * run["bond_order"].isel(part=1)  # (re, im)
     return abs(psi.mean("disk")).rename("global_bond_order")
 
 

@@ -1,5 +1,5 @@
-"""The structure of a packing: its contact network and rattlers, and the bond-orientational
-order ψ₆ of its disks.
+"""The structure of a packing: its contact network and rattlers, the bond-orientational
+order ψ₆ of its disks, and the pressure along a compression.
 
 Contacts: disks i and j touch when their gap |r_ij| − (R_i + R_j) is below ``tolerance``
 times the mean diameter 2⟨R⟩. A jammed packing from an LS compression stopped at a reduced
@@ -125,3 +125,15 @@ def bond_order(position, box, periodic):
 def global_bond_order(position, box, periodic):
     """|Ψ₆| = |⟨ψ₆⟩| over all disks (:func:`bond_order`)."""
     return float(abs(bond_order(position, box, periodic).mean()))
+
+
+def compression_pressure(time, virial, kinetic, packing_fraction):
+    """βP/ρ between consecutive instants of a compression: 1 + ΔX/(2 K̄ Δt), X the cumulative
+    collision virial Σ r_ij·Δp_i, K̄ the kinetic energy averaged over the two ends (growth
+    pumps it in, the rescaling takes it out: it stays near N T), Δt the interval; at the
+    packing fraction of the interval's middle (φ grows as (1 + γ t)², nearly linearly over a
+    short interval). Arrays over the instants; returns (φ, βP/ρ) over the intervals."""
+    time, virial, kinetic, phi = (np.asarray(a, np.float64) for a in (
+        time, virial, kinetic, packing_fraction))
+    pressure = 1.0 + np.diff(virial) / (2.0 * 0.5 * (kinetic[1:] + kinetic[:-1]) * np.diff(time))
+    return 0.5 * (phi[1:] + phi[:-1]), pressure

@@ -77,7 +77,8 @@ EFFECTS = (
                                    "restitution.tangential", "friction.mu")
            + tuple(f"{wall}.{key}" for wall in WALL_SECTIONS
                    for key in ("temperature", "speed", "amplitude")),
-           ("test_growth.py::test_growing_gas_never_overlaps",), ("growth",)),
+           ("compression_eos", "jamming_density",
+            "test_growth.py::test_growing_gas_never_overlaps"), ("growth",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
            ("test_observers.py::test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots",),
            ("unwrap",)),

@@ -29,7 +29,13 @@ from numba.extending import overload
 from sim.effects.rules import effect_rule
 from sim.effects.values import ConfigError
 from sim.engine.inputs import refused, shaped_reals
-from sim.engine.kinematics import VX, shell_exit_time, shell_exit_time_accelerated
+from sim.engine.kinematics import (
+    VX,
+    shell_exit_time,
+    shell_exit_time_accelerated,
+    shrinking_shell_exit_time,
+    shrinking_shell_exit_time_accelerated,
+)
 
 KEYWORDS = {"gravity": (None, "[gx, gy] uniform acceleration, two finite numbers "
                               "(:mod:`sim.effects.gravity`), zero along a periodic axis; None "
@@ -118,16 +124,46 @@ def acceleration(gravity, axis):
     return gravity[axis]
 
 
-def _straight_exit(gravity, dx, dy, vx, vy, delta):
+def shell_exit(gravity, dx, dy, vx, vy, delta, rate):
+    """Time until a disk at displacement d from its shell centre leaves the shell of radius
+    δ, shrinking at ``rate`` for a growing disk (:mod:`sim.effects.growth`; None: a fixed
+    shell): exact on a straight path, a lower bound on a parabola
+    (:func:`sim.engine.kinematics.shell_exit_time`, :func:`shell_exit_time_accelerated` and
+    their shrinking forms). numba picks one of the four by the types of ``gravity`` and
+    ``rate``."""
+    return _exit_rule(gravity, rate)(gravity, dx, dy, vx, vy, delta, rate)
+
+
+def _straight_exit(gravity, dx, dy, vx, vy, delta, rate):
     return shell_exit_time(dx, dy, vx, vy, delta)
 
 
-@effect_rule(_straight_exit)
-def shell_exit(gravity, dx, dy, vx, vy, delta):
-    """Time until a disk at displacement d from its shell centre leaves the shell of radius
-    δ: exact on a straight path, a lower bound on a parabola."""
+def _parabola_exit(gravity, dx, dy, vx, vy, delta, rate):
     g = math.sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1])
     return shell_exit_time_accelerated(dx, dy, vx, vy, g, delta)
+
+
+def _straight_shrinking_exit(gravity, dx, dy, vx, vy, delta, rate):
+    return shrinking_shell_exit_time(dx, dy, vx, vy, delta, rate)
+
+
+def _parabola_shrinking_exit(gravity, dx, dy, vx, vy, delta, rate):
+    g = math.sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1])
+    return shrinking_shell_exit_time_accelerated(dx, dy, vx, vy, g, delta, rate)
+
+
+def _exit_rule(gravity, rate):
+    """The shell-exit rule for gravity and a shrinking rate, each None or not (in Python or
+    as numba types)."""
+    straight = gravity is None or gravity is types.none
+    if rate is None or rate is types.none:
+        return _straight_exit if straight else _parabola_exit
+    return _straight_shrinking_exit if straight else _parabola_shrinking_exit
+
+
+@overload(shell_exit, inline="always")
+def _shell_exit(gravity, dx, dy, vx, vy, delta, rate):
+    return _exit_rule(gravity, rate)
 
 
 def resting_lift(gravity, tc, motion, disks, i, axis, sign):

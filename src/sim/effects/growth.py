@@ -15,13 +15,14 @@ of a pair grows at ṡ = γ (R_i(0) + R_j(0)) (:func:`growth_speed`). Then
     μ (1 + ξ)(ṡ − u) n̂ (:func:`sim.engine.contact.collide_disks`), so that
     u′ − ṡ = −ξ (u − ṡ): the disks part faster than their contact grows;
   * a wall is met when the gap closes at the normal speed plus Ṙ_i = γ R_i(0), and reflects
-    the disk in the frame of its growing edge (:func:`wall_contact`,
-    :func:`sim.effects.walls.hit_wall`);
+    the disk in the frame of its growing edge (:func:`sim.effects.walls.predict_wall_contact`,
+    :func:`sim.effects.walls.hit_wall`, given Ṙ_i as ``edge``);
   * a disk's neighbour shell reaches its radius at its last rebuild, a_i, plus δ_i; the disk
     leaves it when |r_i − c_i| + (R_i(t) − a_i) reaches δ_i, a shell shrinking at Ṙ_i
-    (:func:`shell_exit`). Two disks outside each other's lists, each within its shrunk shell,
-    are then at least R_i(t) + R_j(t) apart. The cells are sized at construction for the
-    largest radii the box can hold (packing fraction 1; :meth:`sim.engine.core.Engine`).
+    (:func:`shell_room`, :func:`sim.effects.gravity.shell_exit`). Two disks outside each
+    other's lists, each within its shrunk shell, are then at least R_i(t) + R_j(t) apart.
+    The cells are sized at construction for the largest radii the box can hold (packing
+    fraction 1; :meth:`sim.engine.core.Engine`).
 
 Growth pumps kinetic energy in at every contact; a system event (:class:`Rescale`,
 :mod:`sim.engine.system`) brings the kinetic energy back to its initial value, every
@@ -43,20 +44,10 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from sim.effects.gravity import acceleration
-from sim.effects.gravity import shell_exit as fixed_shell_exit
 from sim.effects.rules import effect_rule
 from sim.effects.values import ConfigError, positive
-from sim.effects.walls import predict_wall_contact
-from sim.engine.box import SIDE
 from sim.engine.inputs import real_number, refused
-from sim.engine.kinematics import (
-    INF,
-    VX,
-    VY,
-    first_contact_accelerated,
-    shrinking_shell_exit_time,
-)
+from sim.engine.kinematics import INF, VX, VY
 from sim.engine.parameters import per_disk
 from sim.engine.stamps import count_contacts
 from sim.engine.system import advance_all, handler, predict_all
@@ -175,6 +166,17 @@ def grown(growth, length, now):
     return length * (1.0 + growth.rate * now)
 
 
+def _fixed_size(growth, length, now):
+    return length, None
+
+
+@effect_rule(_fixed_size)
+def growing(growth, length, now):
+    """A length of the disks at time 0 at the absolute time ``now`` and the speed it grows
+    at: (:func:`grown`, :func:`growth_speed`); (length, None) without growth."""
+    return grown(growth, length, now), growth.rate * length
+
+
 def growth_speed(growth, length):
     """How fast a length of the disks at time 0 grows, γ length: a contact distance's ṡ, a
     radius's Ṙ (an edge moving out from its centre). None without growth, which the compiled
@@ -191,69 +193,17 @@ def _growth_speed(growth, length):
     return lambda growth, length: growth.rate * length
 
 
-def _fixed_exit(growth, gravity, dx, dy, vx, vy, delta, radius, reach, now):
-    return fixed_shell_exit(gravity, dx, dy, vx, vy, delta)
+def _whole_shell(growth, delta, radius, reach, now):
+    return delta
 
 
-@effect_rule(_fixed_exit)
-def shell_exit(growth, gravity, dx, dy, vx, vy, delta, radius, reach, now):
-    """Time until a disk of initial radius ``radius``, at displacement d from its shell
-    centre, leaves its shell of thickness δ: the shell it may use shrinks by what the disk
-    has grown beyond its reach a_i since its rebuild (R_i(now) − a_i) and then at Ṙ_i. Exact
-    on a straight path; under gravity a lower bound (as
-    :func:`sim.engine.kinematics.shell_exit_time_accelerated`, for a shrinking circle: the
-    straight exit from it, shrunk again by g τ²/2, and the triangle bound
-    |d| + (|v| + Ṙ) τ + g τ²/2 ≤ δ')."""
-    rate = growth.rate * radius
-    room = delta - (grown(growth, radius, now) - reach)
-    return _shrinking_exit(gravity, dx, dy, vx, vy, room, rate)
-
-
-def _straight_shrinking_exit(gravity, dx, dy, vx, vy, room, rate):
-    return shrinking_shell_exit_time(dx, dy, vx, vy, room, rate)
-
-
-@effect_rule(_straight_shrinking_exit)
-def _shrinking_exit(gravity, dx, dy, vx, vy, room, rate):
-    g = math.sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1])
-    tau_straight = shrinking_shell_exit_time(dx, dy, vx, vy, room, rate)
-    tau_shrunk = 0.0
-    if tau_straight < INF:
-        shrunk = room - 0.5 * g * tau_straight * tau_straight
-        if shrunk > 0.0:
-            tau_shrunk = shrinking_shell_exit_time(dx, dy, vx, vy, shrunk, rate)
-    left = room - math.sqrt(dx * dx + dy * dy)
-    tau_triangle = 0.0
-    if left > 0.0:
-        speed = math.sqrt(vx * vx + vy * vy) + rate
-        tau_triangle = 2.0 * left / (speed + math.sqrt(speed * speed + 2.0 * g * left))
-    return max(tau_shrunk, tau_triangle)
-
-
-def _fixed_wall(growth, gravity, motion, axis, t_abs, x, v, radius, geometry, horizon):
-    return predict_wall_contact(gravity, motion, axis, t_abs, x, v, radius, geometry, horizon)
-
-
-@effect_rule(_fixed_wall)
-def wall_contact(growth, gravity, motion, axis, t_abs, x, v, radius, geometry, horizon):
-    """Time until the disk of initial radius ``radius`` at coordinate x (velocity v along
-    ``axis``, at absolute time ``t_abs``) touches a wall of that axis, and the side (0, 1):
-    growing, its gap sign (x − w) − R(t) closes at sign v + Ṙ (under gravity, the first root
-    of the gap's parabola, :func:`sim.engine.kinematics.first_contact_accelerated`). The
-    walls stand still (growth refuses moving ones)."""
-    a = acceleration(gravity, axis)
-    r = grown(growth, radius, t_abs)
-    rate = growth.rate * radius
-    best = INF
-    best_side = -1
-    for side in range(2):
-        sign = 1.0 - 2.0 * side
-        h = sign * (x - geometry[SIDE + axis] * side) - r
-        tau = first_contact_accelerated(h, sign * v - rate, sign * a)
-        if tau < best:
-            best = tau
-            best_side = side
-    return best, best_side
+@effect_rule(_whole_shell)
+def shell_room(growth, delta, radius, reach, now):
+    """The part of its shell's thickness δ a disk of initial radius ``radius`` may still
+    cross: δ less what it has grown beyond its reach a_i since its list was rebuilt,
+    δ − (R_i(now) − a_i); from then on it shrinks at Ṙ_i
+    (:func:`sim.effects.gravity.shell_exit` with the rate :func:`growth_speed`)."""
+    return delta - (grown(growth, radius, now) - reach)
 
 
 @handler(Rescale)

@@ -164,30 +164,32 @@ def wall_state(motion, wall, t_abs, geometry):
             speed + amplitude * omega * math.cos(omega * t_abs))
 
 
-def predict_wall_contact(gravity, motion, axis, t_abs, x, v, radius, geometry, horizon):
+def predict_wall_contact(gravity, motion, axis, t_abs, x, v, radius, edge, geometry, horizon):
     """Time until the disk at coordinate ``x`` with velocity ``v`` along ``axis`` (at absolute
-    time ``t_abs``) touches a wall of that axis. Returns (τ, side): side 0 or 1 for a contact,
-    -1 for a time short of contact at which the disk must be predicted again (a search near a
-    vibrating wall that has not converged yet), τ = inf when no wall is reached. A vibrating
-    wall is not searched beyond ``horizon``, the time of an event known to come first.
-    Still walls without gravity: a straight line to the nearer wall
-    (:func:`sim.engine.kinematics.wall_contact_time`)."""
-    rule = _straight_to_still if gravity is None and motion is None else _first_wall_contact
-    return rule(gravity, motion, axis, t_abs, x, v, radius, geometry, horizon)
+    time ``t_abs``, radius ``radius`` then, its edge moving out at ``edge``: a growing disk's
+    Ṙ, :mod:`sim.effects.growth`, else None) touches a wall of that axis. Returns (τ, side):
+    side 0 or 1 for a contact, -1 for a time short of contact at which the disk must be
+    predicted again (a search near a vibrating wall that has not converged yet), τ = inf
+    when no wall is reached. A vibrating wall is not searched beyond ``horizon``, the time of
+    an event known to come first. Still walls without gravity or growth: a straight line to
+    the nearer wall (:func:`sim.engine.kinematics.wall_contact_time`)."""
+    rule = (_straight_to_still if gravity is None and motion is None and edge is None
+            else _first_wall_contact)
+    return rule(gravity, motion, axis, t_abs, x, v, radius, edge, geometry, horizon)
 
 
 @overload(predict_wall_contact, inline="always")
-def _predict_wall_contact(gravity, motion, axis, t_abs, x, v, radius, geometry, horizon):
-    if gravity is types.none and motion is types.none:
+def _predict_wall_contact(gravity, motion, axis, t_abs, x, v, radius, edge, geometry, horizon):
+    if gravity is types.none and motion is types.none and edge is types.none:
         return _straight_to_still
     return _first_wall_contact
 
 
-def _straight_to_still(gravity, motion, axis, t_abs, x, v, radius, geometry, horizon):
+def _straight_to_still(gravity, motion, axis, t_abs, x, v, radius, edge, geometry, horizon):
     return wall_contact_time(x, v, radius, geometry[SIDE + axis])
 
 
-def _first_wall_contact(gravity, motion, axis, t_abs, x, v, radius, geometry, horizon):
+def _first_wall_contact(gravity, motion, axis, t_abs, x, v, radius, edge, geometry, horizon):
     a = acceleration(gravity, axis)
     best = INF
     best_side = -1
@@ -197,12 +199,13 @@ def _first_wall_contact(gravity, motion, axis, t_abs, x, v, radius, geometry, ho
         rest = geometry[SIDE + axis] * side
         speed, amplitude, omega = wall_motion_of(motion, wall)
         h = sign * (x - rest - speed * t_abs) - radius
+        closing = sign * (v - edge_velocity(speed, sign, edge))
         if amplitude == 0.0:
-            tau = first_contact_accelerated(h, sign * (v - speed), sign * a)
+            tau = first_contact_accelerated(h, closing, sign * a)
             touching = True
         else:
             tau, touching = first_contact_oscillating(
-                h, sign * (v - speed), sign * a, amplitude, omega,
+                h, closing, sign * a, amplitude, omega,
                 omega * t_abs + (0.0 if side == 0 else math.pi),
                 CONTACT_TOLERANCE * geometry[SIDE + axis], min(horizon, best))
         if tau < best:

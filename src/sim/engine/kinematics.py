@@ -320,3 +320,24 @@ def shrinking_shell_exit_time(dx, dy, vx, vy, delta, rate):
     if a > 0.0:
         return (s - b) / a
     return INF
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def shrinking_shell_exit_time_accelerated(dx, dy, vx, vy, g, delta, rate):
+    """:func:`shell_exit_time_accelerated` for a shell shrinking at ``rate``
+    (:func:`shrinking_shell_exit_time`): a time at or before the first exit of a disk on a
+    parabola (|g_vec| = g) from a circle of radius δ − rate τ. The same two lower bounds: the
+    exit τ_s of the straight path from the circle shrunk by g τ_l²/2 (τ_l the straight path's
+    exit), and the triangle bound |d| + (|v| + rate) τ + g τ²/2 ≤ δ."""
+    tau_straight = shrinking_shell_exit_time(dx, dy, vx, vy, delta, rate)
+    tau_shrunk = 0.0
+    if tau_straight < INF:
+        shrunk = delta - 0.5 * g * tau_straight * tau_straight
+        if shrunk > 0.0:
+            tau_shrunk = shrinking_shell_exit_time(dx, dy, vx, vy, shrunk, rate)
+    room = delta - math.sqrt(dx * dx + dy * dy)
+    tau_triangle = 0.0
+    if room > 0.0:
+        speed = math.sqrt(vx * vx + vy * vy) + rate
+        tau_triangle = 2.0 * room / (speed + math.sqrt(speed * speed + 2.0 * g * room))
+    return max(tau_shrunk, tau_triangle)

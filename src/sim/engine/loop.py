@@ -38,12 +38,13 @@ import numpy as np
 from numba import njit
 
 from sim.effects.event_log import log_contact
-from sim.effects.growth import grown, growth_speed, shell_exit, wall_contact
+from sim.effects.gravity import shell_exit
+from sim.effects.growth import growing, grown, shell_room
 from sim.effects.restitution import collapsing, wall_restitution_of
 from sim.effects.rotation import rough_wall_contact
 from sim.effects.tc import tc_restitution
 from sim.effects.thermal_walls import contact_key
-from sim.effects.walls import hit_wall
+from sim.effects.walls import hit_wall, predict_wall_contact
 from sim.engine.box import PERIODIC, fold, image_velocity, separation
 from sim.engine.codes import (
     COLLISIONS,
@@ -132,15 +133,17 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
     vy = table[i, VY]
     r_i = table[i, RADIUS]
     now = t_origin + t
+    r_now, edge = growing(effects.growth, r_i, now)  # R_i(now), Ṙ_i (None: not growing)
     dx, dy = separation(box, x - table[i, CX], y - table[i, CY])
-    tau = shell_exit(effects.growth, gravity, dx, dy, vx, vy, per_disk(disks.delta, i), r_i,
-                     optional_entry(neighbours.reach, i, r_i), now)
+    tau = shell_exit(gravity, dx, dy, vx, vy,
+                     shell_room(effects.growth, per_disk(disks.delta, i), r_i,
+                                optional_entry(neighbours.reach, i, r_i), now), edge)
     partner = SHELL_EXIT
     for axis in range(2):
         if grid[PERIODIC + axis] == 0:
-            tau_w, side = wall_contact(effects.growth, gravity, effects.wall_motion, axis, now,
-                                       table[i, X + axis], table[i, VX + axis], r_i, geometry,
-                                       tau)
+            tau_w, side = predict_wall_contact(gravity, effects.wall_motion, axis, now,
+                                               table[i, X + axis], table[i, VX + axis],
+                                               r_now, edge, geometry, tau)
             if tau_w < tau:
                 tau = tau_w
                 # a search near a vibrating wall that stopped short: predict again from there
@@ -160,11 +163,10 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
         ux, uy = image_velocity(box, dy, ry)
         vx_ij = vx - vx_j - ux
         vy_ij = vy - vy_j - uy
-        sigma = r_i + table[j, RADIUS]
-        tau_ij, event_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij,
-                                           grown(effects.growth, sigma, now),
-                                           growth_speed(effects.growth, sigma), tau,
-                                           optional_entry(neighbours.pair_state, k, 0), disks)
+        sigma, sigma_rate = growing(effects.growth, r_i + table[j, RADIUS], now)
+        tau_ij, event_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij, sigma, sigma_rate,
+                                           tau, optional_entry(neighbours.pair_state, k, 0),
+                                           disks)
         if tau_ij < tau and t + tau_ij <= event_time[j]:
             tau = tau_ij
             partner = j
@@ -196,10 +198,9 @@ def touch_wall(i, wall, t, t_origin, disks, box, effects, tallies, wall_contacts
                           t_last[i], t_last[i])
     key = contact_key(effects.wall_temperature, effects.seed, wall_contacts)
     m = per_disk(disks.mass, i)
-    r_i = disks.table[i, RADIUS]
+    r_now, edge = growing(effects.growth, disks.table[i, RADIUS], t_origin + t)
     lost, impulse, work = hit_wall(i, wall, t_origin + t, xi_w, disks.table, m, box.geometry,
-                                   effects, key, grown(effects.growth, r_i, t_origin + t),
-                                   growth_speed(effects.growth, r_i))
+                                   effects, key, r_now, edge)
     lost += rough_wall_contact(effects.roughness, effects, i, wall, impulse, t, disks, m)
     tallies.wall_impulse[wall] += impulse
     disks.stamp[i] += 1

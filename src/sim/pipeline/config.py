@@ -30,7 +30,7 @@ from sim.effects.values import (
 from sim.engine.inputs import MAX_COUNT
 from sim.pipeline.config_reference import leaves
 from sim.pipeline.initial import RSA_JAMMING
-from sim.pipeline.scenes import SCENES
+from sim.pipeline.scenes import PLACEMENTS, SCENES
 from sim.pipeline.schema import SimConfig, StopConfig, leaf_fields, plain_type
 
 #: the stop conditions of a scene (``stop:``), in the order of conf/config.yaml
@@ -130,8 +130,8 @@ def validate(cfg: Any) -> None:
                           "disks.temperature: one of the two (both are null)")
     positive("disks.speed", d.speed, zero=True)
     positive("disks.temperature", d.temperature, zero=True)
-    if d.placement not in ("random", "lattice", "melted", "auto"):
-        raise ConfigError("disks.placement", d.placement, "random, lattice, melted or auto")
+    if d.placement not in PLACEMENTS and d.placement != "auto":
+        raise ConfigError("disks.placement", d.placement, ", ".join(PLACEMENTS) + " or auto")
     if d.placement == "random" and scene.gas_like:
         area = float(c.box.size[0]) * float(c.box.size[1])
         phi = (d.packing_fraction if d.radius is None

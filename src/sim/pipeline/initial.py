@@ -8,6 +8,9 @@
 * :func:`melted_lattice` — that lattice melted by an elastic run of its own: a random, fluid
   arrangement at packings random addition cannot reach (equal hard disks are fluid below
   φ ≈ 0.70; Bernard & Krauth, Phys. Rev. Lett. 107, 155704 (2011)).
+* :func:`compressed` — a random gas compressed to the packing by growing its disks
+  (Lubachevsky–Stillinger, :mod:`sim.effects.growth`): random at any density up to
+  jamming, with no memory of a lattice, and for any radii.
 * :func:`fixed_speed` (equal speeds, random directions) and
   :func:`maxwellian` (components drawn from N(0, T/m)); :func:`remove_drift` zeroes the total
   momentum.
@@ -347,6 +350,80 @@ def melted_lattice(n, radius, box=(1.0, 1.0), region=None, periodic=(False, Fals
                              f"melt: it stopped after {engine.collisions} of {collisions} "
                              f"collisions ({reason}); use disks.placement=lattice")
     return engine.positions() + lo
+
+
+def two_sizes(n, packing_fraction, radius_ratio, large_fraction, area=1.0, seed=0):
+    """Radii float64[n] and species int32[n] of a mixture of two sizes: round(``large_fraction``
+    × n) large disks (species 1) ``radius_ratio`` times the small ones' radius (species 0),
+    in an order shuffled by ``seed``, all together covering ``packing_fraction`` of ``area``."""
+    call = "two_sizes"
+    n = _count(call, n)
+    large = round(real_number(call, "large_fraction", large_fraction,
+                              lambda f: 0.0 <= f <= 1.0, "a number fraction in [0, 1]") * n)
+    species = np.random.default_rng(_seed(call, seed)).permutation(
+        np.repeat(np.array([0, 1], np.int32), [n - large, large]))
+    relative = np.where(species == 1, real_number(call, "radius_ratio", radius_ratio,
+                                                  lambda r: 1.0 <= r < math.inf,
+                                                  "a finite ratio ≥ 1"), 1.0)
+    small = radius_for_packing(1, packing_fraction, area / float(np.sum(relative**2)))
+    return small * relative, species
+
+
+#: The packing fraction a compression starts from (:func:`compressed`): random sequential
+#: addition reaches it at once, far below its jamming at φ ≈ 0.547.
+COMPRESSION_START = 0.3
+
+#: The growth rate of a compression (:func:`compressed`) in units of √(T/m)/⟨σ⟩: the
+#: contacts grow at 1 % of the thermal speed. Measured (``make figures``, stage jamming): the
+#: fluid's pressure then follows its equation of state up to φ ≈ 0.7.
+COMPRESSION_RATE = 0.01
+
+#: the stream of random numbers of a compression's velocities
+COMPRESSION_STREAM = 8
+
+
+def compressed(radius, box=(1.0, 1.0), region=None, periodic=(False, False), seed=0,
+               rate=COMPRESSION_RATE):
+    """Positions float64[n, 2] of disks of the given radii (a 1-D array, one per disk)
+    compressed to their packing fraction in the region from a random gas: placed by
+    :func:`random_sequential` at radii shrunk to φ = min(φ, :data:`COMPRESSION_START`), then
+    grown at ``rate`` (units of √(T/m)/⟨σ⟩, :mod:`sim.effects.growth`) by an elastic run
+    at T = 1 (unit masses, zero momentum) confined to the region as :func:`melted_lattice`
+    is, until they fill the packing fraction (to round-off, from above: the disks returned
+    have a gap ≥ 0 at the radii asked). No lattice is ever made. A packing the disks jam
+    before reaching (a :class:`PlacementError` naming ``radius``), and one above π/√12 for
+    disks of one size, cannot be made. Deterministic in ``seed``."""
+    from sim.engine.core import Engine
+    from sim.engine.inputs import Boundary
+    from sim.engine.running import CLOSE_PACKING
+
+    call = "compressed"
+    radius = _radii(call, radius)
+    _, lo, hi, wraps = _layout(call, radius, box, region, periodic)
+    seed = _seed(call, seed)
+    rate = real_number(call, "rate", rate, lambda g: 0.0 < g < math.inf, "a finite rate > 0")
+    phi = float(np.pi * np.sum(radius**2) / np.prod(hi - lo))
+    if np.all(radius == radius[0]) and phi > CLOSE_PACKING:
+        raise PlacementError(call, "radius", radius, f"disks of one size at most at φ = π/√12 = "
+                             f"{CLOSE_PACKING:.4f}, their densest packing (asked: {phi:.4f})")
+    start = np.sqrt(min(phi, COMPRESSION_START) / phi) * radius
+    position = random_sequential(start, box=box, region=region, periodic=periodic, seed=seed)
+    if phi <= COMPRESSION_START:
+        return position
+    n = radius.size
+    mass = np.ones(n)
+    rng = np.random.default_rng(np.random.SeedSequence((seed, COMPRESSION_STREAM)))
+    velocity = remove_drift(_gaussian(mass, 1.0, rng), mass)
+    engine = Engine(position - lo, velocity, start, mass,
+                    boundary=Boundary(size=tuple(float(x) for x in hi - lo), periodic=wraps),
+                    growth_rate=rate / (2.0 * float(np.mean(start))))
+    target = phi * (1.0 + 8.0 * np.finfo(float).eps)
+    reason = engine.run(packing_fraction=target)
+    if reason != "packing_fraction":
+        raise PlacementError(call, "radius", radius, f"a packing the disks reach before they "
+                             f"jam: compressed at this rate they jam at φ = "
+                             f"{engine.packing_fraction():.4f}, below the {phi:.4f} asked")
+    return engine.positions(engine.packing_fraction_time(target)) + lo
 
 
 def fixed_speed(n, speed, seed=0):

@@ -22,9 +22,12 @@ from sim.engine.box import nearest_images
 from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.pipeline.initial import (
+    COMPRESSION_RATE,
+    COMPRESSION_START,
     MELT_COLLISIONS_PER_DISK,
     RSA_JAMMING,
     PlacementError,
+    compressed,
     fixed_speed,
     hexagonal_lattice,
     maxwellian,
@@ -32,6 +35,7 @@ from sim.pipeline.initial import (
     radius_for_packing,
     random_sequential,
     remove_drift,
+    two_sizes,
 )
 
 
@@ -134,7 +138,9 @@ def _placement(cfg, n, radius, region=None):
 PLACEMENTS = {"random": "random sequential addition",
               "lattice": "hexagonal lattice (jittered)",
               "melted": f"hexagonal lattice melted by {MELT_COLLISIONS_PER_DISK} elastic "
-                        f"collisions per disk"}
+                        f"collisions per disk",
+              "compressed": f"random gas at φ = {COMPRESSION_START} compressed by growing "
+                            f"disks at ṡ = {COMPRESSION_RATE} √(T/m)"}
 
 
 def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):
@@ -147,6 +153,9 @@ def _place(cfg, radius, n, region=None, key="disks.packing_fraction"):
         if placement == "random":
             return random_sequential(np.full(n, radius), box=box, region=region,
                                      periodic=periodic, seed=cfg.seed)
+        if placement == "compressed":
+            return compressed(np.full(n, radius), box=box, region=region, periodic=periodic,
+                              seed=cfg.seed)
         place = melted_lattice if placement == "melted" else hexagonal_lattice
         return place(n, radius, box=box, region=region, periodic=periodic, seed=cfg.seed)
     except PlacementError as error:
@@ -230,20 +239,15 @@ def _check_compress(c):
 
 
 def _compress_radii(cfg):
-    """Radii float64[n] and species int32[n] of the compress scene: a fraction
-    ``compress.large_fraction`` of large disks (species 1, ``compress.radius_ratio`` times
-    the small radius), shuffled by the seed, the small radius set by the packing fraction."""
+    """Radii float64[n] and species int32[n] of the compress scene (:func:`two_sizes`): the
+    small radius ``disks.radius``, or set by ``disks.packing_fraction``."""
     d, k = cfg.disks, cfg.compress
-    n = int(d.n)
-    large = round(float(k.large_fraction) * n)
-    species = np.random.default_rng(cfg.seed + 2).permutation(
-        np.repeat(np.array([0, 1], np.int32), [n - large, large]))
-    relative = np.where(species == 1, float(k.radius_ratio), 1.0)
-    if d.radius is not None:
-        return float(d.radius) * relative, species
     area = float(cfg.box.size[0]) * float(cfg.box.size[1])
-    return relative * math.sqrt(float(d.packing_fraction) * area
-                                / (math.pi * float(np.sum(relative**2)))), species
+    large = round(float(k.large_fraction) * d.n)
+    phi = (d.packing_fraction if d.radius is None else math.pi * float(d.radius) ** 2
+           * (d.n - large + large * float(k.radius_ratio) ** 2) / area)
+    return two_sizes(int(d.n), float(phi), float(k.radius_ratio), float(k.large_fraction),
+                     area, cfg.seed + 2)
 
 
 def _compress_preparation(cfg):
