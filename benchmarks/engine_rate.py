@@ -8,8 +8,10 @@ contacts and neighbour-shell exits) over all timed collisions, best_chunk_collis
 bytes_per_disk (engine arrays) and rss_bytes_per_disk (peak resident-set growth),
 compile_s (first engine built and run in this process: compilation or cache load), and
 reference_ratio (this engine over the textbook reference engine, same N and φ, same process,
-N ≤ 10⁴). Extra rows compare effects: ξ < 1 with TC, and the crater bed with and without
-its projectile.
+N ≤ 10⁴). Extra rows compare effects: ξ < 1 with TC; growing disks (reference_ratio: their
+rate over that of the same gas not growing) and the compress scene of 10⁴ disks run to
+jamming (its wall time in the scene's name); and the crater bed with and without its
+projectile.
 
     python benchmarks/engine_rate.py                       # the full table
     python benchmarks/engine_rate.py --n 10000 --phi 0.5 --json
@@ -148,6 +150,32 @@ def crater_rows(collisions, seed=1):
     return rows
 
 
+def compress_row(n, seed=0):
+    """The ``compress`` scene (the 50:50 mixture of radius ratio 1.4 grown from φ = 0.3 at its
+    default rate, :mod:`sim.effects.growth`) with ``n`` disks, run to its jamming stop; the
+    engine built (and its loop compiled) before the timing."""
+    from hydra import compose, initialize_config_dir
+
+    from sim.pipeline.config import register
+    from sim.pipeline.overrides import CONF_DIR
+    from sim.pipeline.runner import build_engine
+
+    register()
+    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+        cfg = compose("config", overrides=["scenario=compress", f"disks.n={n}", f"seed={seed}"])
+    engine = build_engine(cfg)
+    started = time.perf_counter()
+    reason = engine.run(jamming=cfg.stop.jamming)
+    seconds = time.perf_counter() - started
+    return {"scene": f"compress to {reason} (βP/ρ = {cfg.stop.jamming:g}) in "
+                     f"{seconds:.1f} s, φ_J = {engine.packing_fraction():.4f}",
+            "n": n, "phi": round(engine.packing_fraction(), 3),
+            "collisions_per_s": round(engine.collisions / seconds),
+            "best_chunk_collisions_per_s": None, "events_per_s": round(engine.events / seconds),
+            "bytes_per_disk": round(engine_bytes(engine) / n, 1), "rss_bytes_per_disk": None,
+            "compile_s": None, "reference_ratio": None}
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, nargs="+", default=[1000, 10_000, 100_000, 1_000_000])
@@ -172,6 +200,18 @@ def main(argv=None):
         n = 10_000
         rows.append(gas_row(n, 0.5, max(args.collisions, 20 * n), args.warmup, 0, args.chunks,
                             restitution=0.9, tc=1e-6))
+        emit(rows[-1], args.json)
+        # growing disks at φ ≈ 0.5 (γ = 0.01: φ grows by about 1 % while timed) against the
+        # first row of this n and φ, and the compress scene run to jamming
+        rows.append(gas_row(n, 0.5, max(args.collisions, 20 * n), args.warmup, 0, args.chunks,
+                            growth_rate=0.01))
+        off = next((r for r in rows if r["scene"] == "gas" and r["n"] == n and r["phi"] == 0.5),
+                   None)
+        if off is not None:
+            rows[-1]["reference_ratio"] = round(rows[-1]["collisions_per_s"]
+                                                / off["collisions_per_s"], 3)
+        emit(rows[-1], args.json)
+        rows.append(compress_row(n))
         emit(rows[-1], args.json)
         for row in crater_rows(min(args.collisions, 2_000_000)):
             rows.append(row)

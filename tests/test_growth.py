@@ -188,6 +188,11 @@ def test_bad_growth_is_refused_in_one_line(keyword, value, allowed):
     assert "\n" not in str(error.value)
 
 
+def test_growth_of_disks_at_rest_is_refused():
+    with pytest.raises(ValueError, match="disks at rest"):
+        Engine(np.array([[0.25, 0.5], [0.75, 0.5]]), np.zeros((2, 2)), 0.1, growth_rate=0.1)
+
+
 def test_growth_with_a_moving_wall_is_refused():
     with pytest.raises(ValueError, match="moving walls"):
         Engine(np.array([[0.25, 0.5], [0.75, 0.5]]), np.ones((2, 2)), 0.1, growth_rate=0.1,
@@ -201,3 +206,65 @@ def test_a_packing_fraction_above_close_packing_is_refused_for_disks_of_one_size
     mixture = _compress("growth.rate=1.0")  # two sizes: a target it cannot reach, jams first
     assert mixture.run(packing_fraction=0.5 * (CLOSE_PACKING + 1.0)) == "jamming"
     assert mixture.packing_fraction() < CLOSE_PACKING
+
+
+#: the fastest and the slowest growth rates of figure 14 (sim.figures.jamming), 1/time
+FASTEST, SLOWEST = 1.0, 0.01
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("boundary", "ratio", "rate", "gravity"), [
+    ("periodic", 1.4, FASTEST, False), ("periodic", 1.4, SLOWEST, False),
+    ("walls", 1.4, FASTEST, False), ("walls", 1.4, SLOWEST, False),
+    ("walls", 1.4, FASTEST, True), ("walls", 1.4, SLOWEST, True),
+    ("periodic", 10.0, FASTEST, False), ("periodic", 10.0, SLOWEST, False),
+    ("walls", 10.0, FASTEST, False), ("walls", 10.0, SLOWEST, False),
+])
+def test_no_overlap_from_dilute_to_jammed(boundary, ratio, rate, gravity):
+    """The overlap audit at every one of 60 stops from φ = 0.3 to jamming (βP/ρ = 10⁶),
+    periodic and walled, gravity on and off, size ratios 1:1.4 and 1:10, at the fastest and
+    the slowest rates of figure 14."""
+    engine = _compress(f"box.boundary={boundary}", f"compress.radius_ratio={ratio}",
+                       f"growth.rate={rate}", "gravity=[0,-1]" if gravity else "gravity=[0,0]")
+    end = (math.sqrt(0.92 / 0.3) - 1.0) / rate  # no packing of these disks is denser
+    reason, stops = "time", 0
+    while reason == "time":
+        reason = engine.run(time=min(engine.time + end / 60.0, end), jamming=1e6)
+        assert_no_overlap(engine)
+        stops += 1
+    assert reason == "jamming" and stops > 10
+    assert engine.packing_fraction() > 0.75
+
+
+@pytest.mark.slow
+def test_a_compressed_placement_is_a_random_fluid_at_the_packing_asked():
+    """``disks.placement=compressed`` at φ = 0.68, beyond random addition: the packing asked
+    (the disks' own radii) without overlap, and a fluid's global order |Ψ₆| < 3/√N."""
+    from sim.analysis.packing import global_bond_order
+    from sim.pipeline.initial import compressed
+
+    n, radius = 1000, 0.0147
+    position = compressed(np.full(n, radius), periodic=(True, True), seed=3)
+    assert overlapping_pairs(position, np.full(n, radius), (1.0, 1.0),
+                             (True, True))[0].size == 0
+    assert global_bond_order(position, (1.0, 1.0), (True, True)) < 3.0 / np.sqrt(n)
+
+
+def test_a_dense_gas_starts_compressed_in_the_compress_scenes_loop():
+    """``auto`` compresses a gas denser than φ = 0.6 (sim.pipeline.scenes.MELT_LIMIT); the
+    preparation runs the compiled loop of the compress scene (a quick test that compiled
+    another would fail), and the gas starts at its packing without overlap."""
+    from sim.pipeline.scenes import preparation
+
+    cfg = compose_scene("gas", "disks.packing_fraction=0.65", "box.boundary=periodic")
+    assert "compressed by growing disks" in preparation(cfg)
+    engine = build_engine(cfg)
+    assert engine.packing_fraction() == pytest.approx(0.65, rel=1e-12)
+    assert_no_overlap(engine)
+
+
+def test_a_compressed_placement_above_close_packing_is_refused():
+    from sim.pipeline.initial import PlacementError, compressed
+
+    with pytest.raises(PlacementError, match="π/√12"):
+        compressed(np.full(100, 0.055), periodic=(True, True))

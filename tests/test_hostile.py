@@ -340,6 +340,23 @@ BAD_INPUT = {
                              "restitution.wall_tangential"),
     "rough-pressure-tensor": ("restitution.tangential=0.5 observe.pressure_tensor=true",
                               "observe.pressure_tensor"),
+    # growing disks
+    "growth-rate--1": ("growth.rate=-1", "growth.rate"),
+    "growth-rate-nan": ("growth.rate=nan", "growth.rate"),
+    "growth-rate-inf": ("growth.rate=inf", "growth.rate"),
+    "rescale-every-0": ("growth.rate=0.1 growth.rescale_every=0", "growth.rescale_every"),
+    "packing-stop-without-growth": ("stop.packing_fraction=0.5", "stop.packing_fraction"),
+    "packing-stop-above-close-packing": ("growth.rate=0.1 stop.packing_fraction=0.95",
+                                         "stop.packing_fraction"),
+    "growth-with-a-piston": ("growth.rate=0.1 walls.top.speed=-0.1", "growth.rate"),
+    "growth-with-a-vibrating-wall": ("growth.rate=0.1 walls.bottom.amplitude=0.01 "
+                                     "walls.bottom.frequency=10", "growth.rate"),
+    "growth-of-rough-disks": ("growth.rate=0.1 restitution.tangential=0.5", "growth.rate"),
+    "compress-without-growth": ("scenario=compress growth.rate=0", "growth.rate"),
+    "compress-ratio-below-1": ("scenario=compress compress.radius_ratio=0.5",
+                               "compress.radius_ratio"),
+    "jamming-pressure-1": ("stop.jamming=1", "stop.jamming"),
+    "placement-unknown": ("disks.placement=squeezed", "disks.placement"),
     # words that are no override: a value cut at a space the shell split, a bare word
     "path-with-a-space-unquoted": ("hydra.run.dir=my runs/x", "quoted"),
     "a-bare-word": ("gas", "KEY=VALUE"),

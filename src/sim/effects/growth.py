@@ -122,6 +122,9 @@ def loop_values(keywords, context):
             raise refused("Engine", "growth_rate", rate, f"None or 0 with {what}: disks grow "
                           f"between still, hard walls only, and are smooth")
     n, energy = context["n"], context["initial_energy"]
+    if not 0.0 < energy < math.inf:
+        raise refused("Engine", "growth_rate", rate, "None or 0 for disks at rest: growing "
+                      "disks are held at their initial kinetic energy, which must be > 0")
     return {"growth": Growth(rate),
             "system_event": Rescale(energy, every * n, np.array(
                 [0.0, 0.0, first_interval(every, context)]))}

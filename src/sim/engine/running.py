@@ -283,9 +283,9 @@ class Running:
 
     @property
     def still(self):
-        """Whether nothing moves, nor ever will: no disk moving, no gravity, no moving wall (a
-        run ends at once, stop reason ``no_events``)."""
-        return (self.gravity is None and self.wall_motion is None
+        """Whether nothing moves, nor ever will: no disk moving, no gravity, no moving wall,
+        no growth (a run ends at once, stop reason ``no_events``)."""
+        return (self.gravity is None and self.wall_motion is None and self.growth is None
                 and not np.any(self.velocities() != 0.0))
 
     def never_holds(self, name, value):
@@ -319,14 +319,15 @@ class Running:
 
     def disks_never_touch(self):
         """Whether no two disks can ever touch: no force acts between contacts (no gravity,
-        every wall still and not thermal), and every pair either moves with one velocity in a
-        periodic box, or keeps an axis fixed on which the two are further apart than contact
-        (a disk with v_x = 0 keeps its x until its first contact, also when it bounces off
-        the walls along y). Above :data:`PAIRWISE_LIMIT` disks only the first holds."""
+        every wall still and not thermal), the disks do not grow, and every pair either moves
+        with one velocity in a periodic box, or keeps an axis fixed on which the two are
+        further apart than contact (a disk with v_x = 0 keeps its x until its first contact,
+        also when it bounces off the walls along y). Above :data:`PAIRWISE_LIMIT` disks only
+        the first holds."""
         if self.n < 2:
             return True
         if self.gravity is not None or self.wall_motion is not None \
-                or self.wall_temperature is not None:
+                or self.wall_temperature is not None or self.growth is not None:
             return False
         velocity = self.velocities()
         periodic = bool(np.all(self.periodic))

@@ -28,6 +28,7 @@ from sim.effects.values import (
     within,
 )
 from sim.engine.inputs import MAX_COUNT
+from sim.engine.running import CLOSE_PACKING
 from sim.pipeline.config_reference import leaves
 from sim.pipeline.initial import RSA_JAMMING
 from sim.pipeline.scenes import PLACEMENTS, SCENES
@@ -92,6 +93,15 @@ def _check_keys(c):
                               "python -m sim --help lists them (+ and ++ add no new keys)")
 
 
+def one_size(c):
+    """Whether every disk of the scene has one radius: the gases, and the compress scene with
+    a radius ratio of 1 or one kind of disk."""
+    if c.scene == "compress":
+        k = c.compress
+        return k.radius_ratio == 1.0 or k.large_fraction in (0.0, 1.0)
+    return SCENES[c.scene].gas_like
+
+
 def validate(cfg: Any) -> None:
     """Check every value of a composed config; raise :class:`ConfigError` on the first bad one."""
     c = cfg if isinstance(cfg, DictConfig) else OmegaConf.structured(cfg)
@@ -153,6 +163,10 @@ def validate(cfg: Any) -> None:
     if s.packing_fraction is not None and not 0.0 < s.packing_fraction < 1.0:
         raise ConfigError("stop.packing_fraction", s.packing_fraction,
                           "a packing fraction in (0, 1) (with growth.rate > 0)")
+    if s.packing_fraction is not None and s.packing_fraction > CLOSE_PACKING and one_size(c):
+        raise ConfigError("stop.packing_fraction", s.packing_fraction,
+                          f"at most π/√12 = {CLOSE_PACKING:.4f}, the densest packing of disks of "
+                          f"one size")
     if s.packing_fraction is not None and c.growth.rate == 0.0:
         raise ConfigError("stop.packing_fraction", s.packing_fraction,
                           "null with growth.rate = 0: disks that do not grow keep their "
