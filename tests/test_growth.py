@@ -127,6 +127,16 @@ def test_growing_gas_never_overlaps(boundary):
     assert 0.78 < engine.packing_fraction() < 0.91
 
 
+def test_growing_disks_whose_collisions_outrun_float64_have_jammed():
+    """Without a pressure watch the compression runs on until its collisions come closer in
+    time than float64 resolves: the disks have jammed (no StalledError), and no pair
+    overlaps."""
+    engine = _compress("growth.rate=1.0")
+    assert engine.run(time=100.0) == "jamming"
+    assert 0.8 < engine.packing_fraction() < 0.91
+    assert_no_overlap(engine)
+
+
 def test_the_packing_fraction_stop_reaches_its_target_to_round_off():
     engine = _compress("growth.rate=1.0")
     assert engine.run(packing_fraction=0.7) == "packing_fraction"

@@ -100,6 +100,8 @@ class Running:
             if status == codes.STATUS_LIST_FULL:
                 self._grow_lists(disk)
                 continue
+            if status == codes.STATUS_STALLED and self.growth is not None:
+                return status  # growing disks jam: their collision rate diverges (run: jamming)
             if status == codes.STATUS_STALLED:
                 self._check_piston()  # a jammed piston stalls the clock too: say so
                 last = (f"a {codes.kind(codes.SYSTEM)}" if disk < 0 else
@@ -137,7 +139,9 @@ class Running:
         jamming : stop once the reduced pressure βP/ρ = 1 + X/(2 K Δt) (X the collision
             virial Σ r_ij·Δp_i over the last :data:`JAMMING_WATCH_EVENTS` events per disk
             or ``chunk_events``, whichever is fewer, Δt their time, K the kinetic energy)
-            exceeds this
+            exceeds this. Growing disks whose collisions come closer in time than float64
+            resolves (a stalled clock, :class:`StalledError` for others) have jammed too:
+            their run stops with the reason ``jamming`` whatever its conditions
         wall_seconds : wall-clock budget of this call (compiling the loop not counted:
             :attr:`compile_seconds`), checked between chunks, which are then
             sized to take about :data:`TIMED_CHUNK_SECONDS` each (from the rate of the chunk
@@ -191,7 +195,7 @@ class Running:
         reasons = {codes.STATUS_COLLISION_LIMIT: "collisions",
                    codes.STATUS_CONTACT_LIMIT: "contacts", codes.STATUS_TIME_REACHED: "time",
                    codes.STATUS_ENERGY_REACHED: "energy_fraction",
-                   codes.STATUS_NO_EVENTS: "no_events"}
+                   codes.STATUS_NO_EVENTS: "no_events", codes.STATUS_STALLED: "jamming"}
         chunk = chunk_events if wall_seconds is None else min(chunk_events, TIMED_FIRST_CHUNK)
         # where ``until`` (and the jamming watch, every JAMMING_WATCH_EVENTS per disk) is
         # asked next

@@ -114,7 +114,8 @@ def make_movie(run_path, out=None, fps=30.0, frames=None, duration=None, color="
         layout = Layout.of_view(walls.view(times))
         picture = Picture(layout, walls, colors, radius, mass,
                           f"{ds.attrs['scene']}: {ds.sizes['disk']} disks",
-                          clock_decimals(times))
+                          clock_decimals(times),
+                          float((snapshots.config.get("growth") or {}).get("rate", 0.0)))
         pictures = (picture.render(frame) for frame in snapshots.frames(times))
         if gif:
             write_gif(partial, pictures, fps)

@@ -9,6 +9,7 @@ from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from sim.effects.growth import scale
 from sim.effects.walls import wall_motion, wall_state
 from sim.engine.box import WALL_NAMES
 from sim.figures.movie.layout import (
@@ -71,9 +72,11 @@ class Picture:
     """One figure redrawn for each frame: the disks, the walls, the clock, the kinetic energy
     and the colour key; :meth:`render` gives a frame's pixels."""
 
-    def __init__(self, layout, walls, colors, radius, mass, title, time_decimals):
+    def __init__(self, layout, walls, colors, radius, mass, title, time_decimals,
+                 growth_rate=0.0):
         self.walls, self.colors = walls, colors
         self.radius, self.mass = radius, mass
+        self.growth_rate = growth_rate  # γ of growing disks (sim.effects.growth), else 0
         self.time_decimals = time_decimals
         self.figure = Figure(figsize=(layout.width / DPI, layout.height / DPI), dpi=DPI)
         self.canvas = FigureCanvasAgg(self.figure)
@@ -133,9 +136,10 @@ class Picture:
         """The pixels uint8[height, width, 3] of ``frame``."""
         if self.disks is not None:
             self.disks.remove()
-        centres, index = periodic_images(frame.position, self.radius, self.walls.box,
+        radius = self.radius * scale(self.growth_rate, frame.time)
+        centres, index = periodic_images(frame.position, radius, self.walls.box,
                                          self.walls.periodic)
-        diameter = 2.0 * self.radius[index]
+        diameter = 2.0 * radius[index]
         colors, caption = self.colors(frame)
         self.disks = self.axes.add_collection(EllipseCollection(
             diameter, diameter, np.zeros_like(diameter), units="xy", offsets=centres,
