@@ -47,7 +47,7 @@ from numba.extending import overload
 from sim.effects.rules import effect_rule
 from sim.effects.values import ConfigError, positive
 from sim.engine.inputs import real_number, refused
-from sim.engine.kinematics import INF, VX, VY
+from sim.engine.kinematics import VX, VY
 from sim.engine.parameters import per_disk
 from sim.engine.stamps import count_contacts
 from sim.engine.system import advance_all, handler, predict_all
@@ -141,8 +141,6 @@ def first_interval(every, context):
     sigma = 2.0 * float(np.mean(radius))
     temperature = context["initial_energy"] / n
     mass = float(np.mean(context["mass"]))
-    if temperature <= 0.0:
-        return INF
     contact_value = (1.0 - 7.0 * phi / 16.0) / (1.0 - phi) ** 2
     frequency = 2.0 * sigma * (n / area) * contact_value * math.sqrt(math.pi * temperature / mass)
     return 2.0 * every / frequency
