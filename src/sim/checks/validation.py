@@ -29,6 +29,7 @@ from sim.analysis.theory import (
 from sim.checks import dsmc
 from sim.checks.gases import cooling_gas, equilibrated_gas
 from sim.checks.jamming import compression_eos, jamming_density
+from sim.checks.melting import small_n_pressure
 from sim.checks.rough import rough_cooling, rough_equipartition
 from sim.checks.rows import Check, block_means, ratio_of_means
 from sim.engine.core import Engine
@@ -484,4 +485,5 @@ STUDIES = {
        for xi, beta in ((0.9, 0.5), (0.9, 0.0), (0.8, -0.5), (0.7, 0.5))},
     "compression_eos": compression_eos,
     "jamming_density": jamming_density,
+    "melting_small_n": small_n_pressure,
 }

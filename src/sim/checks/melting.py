@@ -1,0 +1,83 @@
+"""The equation of state of elastic hard disks at the published sizes and boxes, against
+Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157, 234111 (2022)
+(``data/li_2022.csv``: βP d² with its error per N, box and φ).
+
+A state point: N disks at packing fraction φ in a periodic box of aspect ratio L_x/L_y
+(L_y = 1), placed as ``auto`` places a gas (:func:`sim.pipeline.initial.compressed` above
+φ = 0.6), Maxwellian at T = 1 with zero total momentum; an equilibration of ``warmup``
+collisions per disk; then blocks of collisions whose pressures (:func:`sim.analysis.
+equation_of_state.reduced_pressure_d2`, exact for zero momentum) give the mean and its
+blocking error.
+"""
+
+import csv
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from sim.analysis.equation_of_state import blocking, reduced_pressure_d2
+from sim.checks.rows import Check
+from sim.engine import Boundary, Engine
+from sim.pipeline.initial import compressed, maxwellian, random_sequential, remove_drift
+
+REFERENCE = Path(__file__).with_name("data") / "li_2022.csv"
+
+
+def reference(n, box):
+    """The published (φ, βP d², error) float64 arrays of ``n`` disks in the box ``box`` (as
+    ``data/li_2022.csv`` names it: ``"1:1"``, ``"9:8√3/2"``, …) and its aspect ratio."""
+    with open(REFERENCE, encoding="utf-8") as file:
+        rows = [row for row in csv.DictReader(line for line in file if not line.startswith("#"))
+                if int(row["n"]) == n and row["box"] == box]
+    if not rows:
+        raise ValueError(f"no published pressures of N = {n} in the box {box}")
+    values = np.array([[float(row[k]) for k in ("packing_fraction", "pressure_d2", "error")]
+                       for row in rows])
+    return values[:, 0], values[:, 1], values[:, 2], float(rows[0]["aspect"])
+
+
+def state_point(n, aspect, phi, seed=0, warmup=100, collisions=20_000, blocks=256):
+    """βP d² of ``n`` disks at ``phi`` in a periodic box of aspect ratio ``aspect``:
+    (mean, blocking error, converged, collisions per disk run) over ``blocks`` blocks of
+    ``collisions`` collisions per disk in all, after ``warmup`` collisions per disk."""
+    box = (aspect, 1.0)
+    radius = math.sqrt(phi * aspect / (n * math.pi))
+    periodic = (True, True)
+    place = compressed if phi > 0.5 else random_sequential
+    position = place(np.full(n, radius), box=box, periodic=periodic, seed=seed)
+    mass = np.ones(n)
+    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
+    engine = Engine(position, velocity, radius, boundary=Boundary(size=box, periodic=periodic))
+    engine.run(collisions=warmup * n)
+    per_block = max(1, collisions * n // blocks)
+    kinetic = engine.kinetic_energy()
+    pressures = []
+    for _ in range(blocks):
+        virial, started = engine.virial, engine.time
+        engine.run(collisions=engine.collisions + per_block)
+        pressures.append(reduced_pressure_d2(n, kinetic, engine.virial - virial,
+                                             engine.time - started, aspect, 2.0 * radius))
+    mean, error, converged, _ = blocking(pressures)
+    return mean, error, converged, warmup + blocks * per_block / n
+
+
+def small_n_pressure(n=72, box="1:1", phis=(0.65,), seed=0, collisions=300_000):
+    """βP d² of N = ``n`` in the published box at ``phis`` against Li et al. 2022: within
+    three combined standard errors (theirs and the blocking error of the run, about 0.002
+    after ``collisions`` per disk)."""
+    started = time.perf_counter()
+    published_phi, published, published_error, aspect = reference(n, box)
+    rows = []
+    for phi in phis:
+        k = int(np.argmin(np.abs(published_phi - phi)))
+        mean, error, converged, per_disk = state_point(n, aspect, phi, seed,
+                                                       collisions=collisions)
+        rows.append(Check(
+            f"βP d², N = {n}, box {box}, φ = {phi} ({per_disk:.3g} collisions per disk"
+            f"{'' if converged else ', blocking not converged'})", mean, float(published[k]),
+            3.0 * math.hypot(error, float(published_error[k])),
+            "Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth 2022 (ECMC)",
+            time.perf_counter() - started if not rows else None))
+    return rows
