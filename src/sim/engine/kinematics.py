@@ -301,7 +301,8 @@ def shrinking_shell_exit_time(dx, dy, vx, vy, delta, rate):
 
     Squared: A τ² + 2 B τ + C = 0 with A = |v|² − rate², B = d·v + δ rate, C = |d|² − δ² < 0
     inside. The shrinking radius reaches zero at δ/rate, where |d + v τ| ≥ 0, so the first
-    root of the squared equation is the exit. B > 0: τ = −C/(B + √D); B ≤ 0 (then A > 0):
+    root of the squared equation is the exit. D = B² − A C is formed without cancellation (as
+    in :func:`growing_contact_time`). B > 0: τ = −C/(B + √D); B ≤ 0 (then A > 0):
     τ = (√D − B)/A (as :func:`shell_exit_time`, which this is at rate 0). A disk found outside
     by round-off leaves at once (τ = 0); one whose speed and shrinking are both below
     ``TINY_SPEED_SQUARED`` counts as at rest, never leaving.
@@ -313,8 +314,13 @@ def shrinking_shell_exit_time(dx, dy, vx, vy, delta, rate):
     if c >= 0.0:
         return 0.0
     a = v_squared - rate * rate
-    b = dx * vx + dy * vy + delta * rate
-    s = math.sqrt(max(b * b - a * c, 0.0))
+    d_dot_v = dx * vx + dy * vy
+    b = d_dot_v + delta * rate
+    cross = dx * vy - dy * vx
+    # D = B² − A C formed as |v|² δ² − (d × v)² + rate (rate |d|² + 2 δ d·v): a disk far slower
+    # than its shell shrinks keeps |v|² (lost in A = |v|² − rate²), so its exit is not late
+    s = math.sqrt(max(v_squared * delta * delta - cross * cross
+                      + rate * (rate * (dx * dx + dy * dy) + 2.0 * delta * d_dot_v), 0.0))
     if b > 0.0:
         return -c / (b + s)
     if a > 0.0:
