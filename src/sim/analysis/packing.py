@@ -26,6 +26,7 @@ from scipy.spatial import Delaunay
 
 from sim.checks.audit import kd_tree
 from sim.engine.box import folded, nearest_images
+from sim.engine.observables import virial_pressure
 
 #: tolerances of :func:`contact_numbers`, in units of the mean diameter: from below the
 #: contacts' gaps of an LS packing at βP/ρ ≈ 10⁶ to above them
@@ -149,12 +150,14 @@ def global_bond_order(position, box, periodic):
 
 
 def compression_pressure(time, virial, kinetic, packing_fraction):
-    """βP/ρ between consecutive instants of a compression: 1 + ΔX/(2 K̄ Δt), X the cumulative
-    collision virial Σ r_ij·Δp_i, K̄ the kinetic energy averaged over the two ends (growth
+    """βP/ρ between consecutive instants of a compression: 1 + ΔX/(2 K̄ Δt)
+    (:func:`sim.engine.observables.virial_pressure`), X the cumulative collision virial
+    Σ r_ij·Δp_i, K̄ the kinetic energy averaged over the two ends (growth
     pumps it in, the rescaling takes it out: it stays near N T), Δt the interval; at the
     packing fraction of the interval's middle (φ grows as (1 + γ t)², nearly linearly over a
     short interval). Arrays over the instants; returns (φ, βP/ρ) over the intervals."""
     time, virial, kinetic, phi = (np.asarray(a, np.float64) for a in (
         time, virial, kinetic, packing_fraction))
-    pressure = 1.0 + np.diff(virial) / (2.0 * 0.5 * (kinetic[1:] + kinetic[:-1]) * np.diff(time))
+    pressure = virial_pressure(np.diff(virial), 0.5 * (kinetic[1:] + kinetic[:-1]),
+                               np.diff(time))
     return 0.5 * (phi[1:] + phi[:-1]), pressure

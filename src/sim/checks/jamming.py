@@ -17,6 +17,7 @@ import numpy as np
 from sim.analysis.packing import compression_pressure, contact_number
 from sim.analysis.theory import mixture_z
 from sim.checks.rows import Check, block_means
+from sim.effects.growth import growth_rate
 from sim.engine import Boundary, Engine
 from sim.pipeline.initial import maxwellian, random_sequential, remove_drift, two_sizes
 
@@ -45,14 +46,9 @@ def mixture(n, seed, rate, start=START):
     position = random_sequential(radius, periodic=periodic, seed=seed)
     mass = np.ones(n)
     velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
+    temperature = 0.5 * float(np.sum(mass[:, None] * velocity**2)) / n  # 2D: K = N T
     return Engine(position, velocity, radius, mass, species, Boundary(periodic=periodic),
-                  growth_rate=rate * math.sqrt(velocity_scale(velocity, mass))
-                  / (2.0 * float(np.mean(radius))))
-
-
-def velocity_scale(velocity, mass):
-    """T/m of the disks: their kinetic energy per disk over the mean mass (2D: K = N T)."""
-    return float(0.5 * np.sum(mass[:, None] * velocity**2) / mass.size / np.mean(mass))
+                  growth_rate=growth_rate(rate, radius, temperature / float(np.mean(mass))))
 
 
 def pressure_along(engine, packing_fractions):

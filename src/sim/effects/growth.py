@@ -5,7 +5,7 @@ Stillinger, J. Comput. Phys. 202, 737 and 765 (2005)).
 Radii grow as R_i(T) = R_i(0)(1 + γ T) in absolute time T, so a polydisperse packing keeps its
 size ratios; masses stay fixed. The engine's table keeps R_i(0); every compiled place that
 needs a size asks :func:`grown` for it at the time of the question, and the contact distance
-of a pair grows at ṡ = γ (R_i(0) + R_j(0)) (:func:`growth_speed`). Then
+of a pair grows at ṡ = γ (R_i(0) + R_j(0)) (:func:`growing`). Then
 
   * a pair touches at the first root of |r + v τ| = σ + ṡ τ
     (:func:`sim.engine.kinematics.growing_contact_time`, through
@@ -44,8 +44,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
+from numba import njit
 
 from sim.effects.rules import effect_rule
 from sim.effects.values import ConfigError, positive
@@ -149,6 +148,13 @@ def first_interval(every, context):
     return 2.0 * every / frequency
 
 
+def growth_rate(relative, radius, temperature_per_mass):
+    """γ at which contacts of the mean diameter ⟨σ⟩ = 2⟨R⟩ of ``radius`` (at time 0) grow at
+    ``relative`` times the thermal speed √(T/m): Γ √(T/m)/⟨σ⟩. Γ = ṡ √(m/T)/⟨σ⟩ is the rate
+    that compares compressions of any size and temperature."""
+    return relative * math.sqrt(temperature_per_mass) / (2.0 * float(np.mean(radius)))
+
+
 def scale(rate, time):
     """R(t)/R(0) = 1 + γ t at absolute time t (1 without growth)."""
     return 1.0 if not rate else 1.0 + rate * time
@@ -176,25 +182,13 @@ def _fixed_size(growth, length, now):
 
 @effect_rule(_fixed_size)
 def growing(growth, length, now):
-    """A length of the disks at time 0 at the absolute time ``now`` and the speed it grows
-    at: (:func:`grown`, :func:`growth_speed`); (length, None) without growth."""
-    return grown(growth, length, now), growth.rate * length
-
-
-def growth_speed(growth, length):
-    """How fast a length of the disks at time 0 grows, γ length: a contact distance's ṡ, a
-    radius's Ṙ (an edge moving out from its centre). None without growth, which the compiled
-    code takes as another type and compiles away (the contact of disks that do not grow,
+    """A length of the disks at time 0 at the absolute time ``now`` (:func:`grown`) and the
+    speed γ length it grows at: a contact distance's ṡ, a radius's Ṙ (an edge moving out from
+    its centre). Without growth (length, None): the compiled code takes None as another type
+    and compiles away what it would do (the contact of disks that do not grow,
     :func:`sim.engine.pairs.pair_event_time`, :func:`sim.engine.contact.growth_frame`,
     :func:`sim.effects.walls.edge_velocity`)."""
-    return None if growth is None else growth.rate * length
-
-
-@overload(growth_speed, inline="always")
-def _growth_speed(growth, length):
-    if growth is types.none:
-        return lambda growth, length: None
-    return lambda growth, length: growth.rate * length
+    return grown(growth, length, now), growth.rate * length
 
 
 def _whole_shell(growth, delta, radius, reach, now):
@@ -206,7 +200,7 @@ def shell_room(growth, delta, radius, reach, now):
     """The part of its shell's thickness δ a disk of initial radius ``radius`` may still
     cross: δ less what it has grown beyond its reach a_i since its list was rebuilt,
     δ − (R_i(now) − a_i); from then on it shrinks at Ṙ_i
-    (:func:`sim.effects.gravity.shell_exit` with the rate :func:`growth_speed`)."""
+    (:func:`sim.effects.gravity.shell_exit` with the speed of :func:`growing`)."""
     return delta - (grown(growth, radius, now) - reach)
 
 

@@ -15,6 +15,14 @@ from sim.engine.kinematics import T_OWN, VX, VY, X, Y
 from sim.engine.stamps import count_all_contacts
 
 
+def virial_pressure(virial, kinetic, elapsed):
+    """βP/ρ = 1 + X/(2 K Δt) from the collision virial X = Σ r_ij·Δp_i of a time Δt and the
+    kinetic energy K (K = N kT in two dimensions; Alder & Wainwright, J. Chem. Phys. 33, 1439
+    (1960)); numbers or arrays. With zero total momentum kT is K/(N − 1):
+    :func:`sim.analysis.equation_of_state.pressure_area`."""
+    return 1.0 + virial / (2.0 * kinetic * elapsed)
+
+
 class Observables:
     """Read-outs of the engine's state (the engine's observing part)."""
 

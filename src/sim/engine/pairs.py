@@ -56,7 +56,7 @@ from numba.core.errors import TypingError
 from numba.extending import overload
 
 from sim.effects.event_log import log_contact
-from sim.effects.growth import growth_speed
+from sim.effects.growth import growing
 from sim.effects.pressure_tensor import add_virial_tensor
 from sim.effects.restitution import collapsing, disk_restitution
 from sim.effects.rotation import rough_collision
@@ -270,8 +270,8 @@ def collide(i, j, t, t_origin, disks, box, effects, tallies, contact):
                         t, t_last[i], t_last[j])
     m_i = per_disk(disks.mass, i)
     m_j = per_disk(disks.mass, j)
-    lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j,
-                                 growth_speed(effects.growth, table[i, RADIUS] + table[j, RADIUS]))
+    sigma_rate = growing(effects.growth, table[i, RADIUS] + table[j, RADIUS], t_origin + t)[1]
+    lost, virial = collide_disks(i, j, rx, ry, xi, table, m_i, m_j, sigma_rate)
     add_virial_tensor(effects.virial_tensor, rx, ry, virial)
     lost += rough_collision(effects.roughness, effects, i, j, rx, ry, virial, t, disks, m_i,
                             m_j)

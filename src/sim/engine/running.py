@@ -21,6 +21,7 @@ from sim.engine.errors import (
 from sim.engine.groups import Disks, Limits, Parts, Schedule, Tallies
 from sim.engine.inputs import MAX_COUNT, STOP_NAMES, check_reachable, check_stop, refused
 from sim.engine.kinematics import TINY_SPEED_SQUARED, VX, VY, X, Y
+from sim.engine.observables import virial_pressure
 from sim.engine.pairs import keeps
 
 #: With a wall-clock budget (``Engine.run(wall_seconds=...)``) chunks of events are sized to
@@ -261,15 +262,15 @@ class Running:
         return time_of_scale(self.growth.rate, math.sqrt(target / self.packing_fraction(0.0)))
 
     def reduced_pressure(self, since_time, since_virial):
-        """βP/ρ = 1 + X / (2 K Δt) from the collision virial X = Σ r_ij·Δp_i since the
-        absolute time ``since_time`` (when the virial was ``since_virial``), Δt the time since
-        and K the kinetic energy now (K = N kT in two dimensions; growth's rescaling keeps it
-        at its initial value); inf when no time has passed."""
+        """βP/ρ (:func:`sim.engine.observables.virial_pressure`) from the collision virial
+        since the absolute time ``since_time`` (when it was ``since_virial``) and the kinetic
+        energy now (growth's rescaling keeps it at its initial value); inf when no time has
+        passed."""
         elapsed = self.time - since_time
         kinetic = self.kinetic_energy()
         if elapsed <= 0.0 or kinetic <= 0.0:
             return math.inf
-        return 1.0 + (self.virial - since_virial) / (2.0 * kinetic * elapsed)
+        return virial_pressure(self.virial - since_virial, kinetic, elapsed)
 
     def _refuse_unreachable(self, given, checked):
         """:func:`check_reachable` for the stop conditions ``given`` to :meth:`run` (name →

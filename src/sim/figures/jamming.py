@@ -26,6 +26,8 @@ state of one size, φ ≈ 0.826, is reached only by suppressing that order: Atki
 Stillinger & Torquato, PNAS 111, 18436 (2014)).
 """
 
+from typing import NamedTuple
+
 import numpy as np
 import yaml
 
@@ -33,6 +35,7 @@ from sim.analysis.datasets import global_bond_order, open_sweep
 from sim.analysis.packing import compression_pressure, contact_number
 from sim.analysis.theory import free_volume_z, mixture_z
 from sim.checks.jamming import CONTACT_TOLERANCE, LARGE_FRACTION, PUBLISHED_JAMMING, RADIUS_RATIO
+from sim.effects.growth import growth_rate
 from sim.figures.style import figure, save
 
 NAME = "fig14_jamming"
@@ -73,16 +76,28 @@ def _packing(run):
 
 
 def _dimensionless(run, rate):
-    """Γ = γ ⟨σ(0)⟩ √(m/T) of a run (T = K/N at the start, m the mean mass)."""
+    """Γ of a run grown at γ = ``rate``: the inverse of :func:`sim.effects.growth.growth_rate`
+    at its start (T = K/N, m the mean mass)."""
     temperature = float(run["kinetic_energy"].values[0]) / run.sizes["disk"]
-    return rate * 2.0 * float(run["radius"].mean()) * np.sqrt(
-        float(run["mass"].mean()) / temperature)
+    return rate / growth_rate(1.0, run["radius"].values, temperature / float(run["mass"].mean()))
+
+
+class Packing(NamedTuple):
+    """One run compressed to jamming."""
+    relative_rate: float  # Γ
+    rate: float  # γ
+    jammed: float  # φ_J
+    contacts: float  # z of the backbone
+    rattlers: float  # their fraction
+    interval_phi: np.ndarray  # φ at the middle of each interval between snapshots
+    pressure: np.ndarray  # βP/ρ over each interval
+    order: np.ndarray  # |Ψ₆| at each snapshot
+    phi: np.ndarray  # φ at each snapshot
 
 
 def _jammed(sweep):
-    """Per run: (Γ, φ_J, z, rattler fraction, φ at the intervals [snapshots − 1], βP/ρ over
-    them, |Ψ₆| [snapshots], φ [snapshots], γ)."""
-    rows = []
+    """Every run of a sweep as a :class:`Packing`."""
+    packings = []
     for rate, run in _runs(sweep):
         phi = _packing(run)
         box, periodic = run.attrs["box"], [b == "periodic" for b in run.attrs["boundary"]]
@@ -92,9 +107,9 @@ def _jammed(sweep):
         middle, pressure = compression_pressure(run["time"].values,
                                                 run["collision_virial"].values,
                                                 run["kinetic_energy"].values, phi)
-        rows.append((_dimensionless(run, rate), phi[-1], z, rattlers, middle, pressure,
-                     global_bond_order(run).values, phi, rate))
-    return rows
+        packings.append(Packing(_dimensionless(run, rate), rate, phi[-1], z, rattlers, middle,
+                                pressure, global_bond_order(run).values, phi))
+    return packings
 
 
 def draw(runs, sweeps, out_dir):
@@ -102,17 +117,17 @@ def draw(runs, sweeps, out_dir):
     one_size = _jammed(open_sweep(sweeps["one_size"]))
     fig, axes = figure(ncols=4, width=18)
     table = []
-    by_rate = {}  # mean Γ of the runs at one γ (the seeds' temperatures differ a little)
-    for gamma in sorted({row[8] for row in mixture}):
-        group = [row for row in mixture if row[8] == gamma]
-        by_rate[float(np.mean([r[0] for r in group]))] = group
+    by_rate = {}  # the mean Γ of the runs at one γ (the seeds' temperatures differ a little)
+    for gamma in sorted({p.rate for p in mixture}):
+        group = [p for p in mixture if p.rate == gamma]
+        by_rate[float(np.mean([p.relative_rate for p in group]))] = group
     rates = list(by_rate)
     for g, group in by_rate.items():
-        phis, zs = np.array([r[1] for r in group]), np.array([r[2] for r in group])
+        phis, zs = np.array([p.jammed for p in group]), np.array([p.contacts for p in group])
         axes[0].plot([g] * len(phis), phis, ".", color="C0", alpha=0.6)
         axes[0].errorbar(g, phis.mean(), phis.std(ddof=1), fmt="s", color="C0", capsize=3)
-        table.append((g, group[0][8], phis.mean(), phis.std(ddof=1), zs.mean(),
-                      zs.std(ddof=1), np.mean([r[3] for r in group]), len(group)))
+        table.append((g, group[0].rate, phis.mean(), phis.std(ddof=1), zs.mean(),
+                      zs.std(ddof=1), np.mean([p.rattlers for p in group]), len(group)))
     low, high = PUBLISHED_JAMMING
     axes[0].axhspan(low, high, color="0.85", label="published, 0.84–0.853 (energy "
                     "minimisation)")
@@ -120,7 +135,7 @@ def draw(runs, sweeps, out_dir):
                 title=f"1:{RADIUS_RATIO} mixture jams at φ_J ({table[0][7]} seeds per rate)")
     axes[0].legend(fontsize=7)
     for g, group in by_rate.items():
-        axes[1].plot([r[1] for r in group], [r[2] for r in group], "o", ms=4,
+        axes[1].plot([p.jammed for p in group], [p.contacts for p in group], "o", ms=4,
                      label=f"Γ = {g:.2g}")
     axes[1].axhline(4.0, color="k", lw=1, label="isostatic z = 4")
     axes[1].set(xlabel="φ_J", ylabel="z of the backbone",
@@ -128,13 +143,14 @@ def draw(runs, sweeps, out_dir):
     axes[1].legend(fontsize=7)
     slowest = by_rate[rates[0]]
     edges = np.arange(0.3, 0.86, 0.01)
-    middle = np.concatenate([r[4] for r in slowest])
-    pressure = np.concatenate([r[5] for r in slowest])
+    middle = np.concatenate([p.interval_phi for p in slowest])
+    pressure = np.concatenate([p.pressure for p in slowest])
     which = np.digitize(middle, edges)
-    centres = np.array([middle[which == k].mean() for k in np.unique(which)])
-    means = np.array([pressure[which == k].mean() for k in np.unique(which)])
-    errors = np.array([pressure[which == k].std(ddof=1) / np.sqrt((which == k).sum())
-                       if (which == k).sum() > 1 else np.nan for k in np.unique(which)])
+    bins = [which == k for k in np.unique(which)]
+    centres = np.array([middle[b].mean() for b in bins])
+    means = np.array([pressure[b].mean() for b in bins])
+    errors = np.array([pressure[b].std(ddof=1) / np.sqrt(b.sum()) if b.sum() > 1 else np.nan
+                       for b in bins])
     phi_j = table[0][2]
     axes[2].errorbar(centres, means, errors, fmt=".", color="C0", ms=3,
                      label=f"Γ = {rates[0]:.2g}, {len(slowest)} seeds")
@@ -148,21 +164,24 @@ def draw(runs, sweeps, out_dir):
     axes[2].set(yscale="log", xlabel="φ", ylabel="βP/ρ", title="pressure along the slowest "
                 "compression")
     axes[2].legend(fontsize=7)
-    for label, rows, color in (("one size", one_size, "C3"), ("mixture", slowest, "C0")):
-        gammas = sorted({r[8] for r in rows})
+    for label, packings, color in (("one size", one_size, "C3"), ("mixture", slowest, "C0")):
+        gammas = sorted({p.rate for p in packings})
         for gamma in gammas:
-            run = next(r for r in rows if r[8] == gamma)  # the first seed
-            axes[3].plot(run[7], run[6], color=color, ls="-" if gamma == gammas[0] else ":",
-                         label=f"{label}, Γ = {run[0]:.2g}: φ_J = {run[1]:.3f}")
-    axes[3].set(xlabel="φ", ylabel="|Ψ₆|", title="bond order as the disks grow")
+            first = next(p for p in packings if p.rate == gamma)  # the first seed
+            axes[3].plot(first.phi, first.order, color=color, marker=".", ms=3,
+                         ls="-" if gamma == gammas[0] else ":",
+                         label=f"{label}, Γ = {first.relative_rate:.2g}: φ_J = "
+                               f"{first.jammed:.3f}")
+    axes[3].set(xlabel="φ", ylabel="|Ψ₆|",
+                title="|Ψ₆| at each snapshot (first seed)")
     axes[3].legend(fontsize=7)
     np.savetxt(out_dir / f"{NAME}.csv", np.array(table), delimiter=",", fmt="%.6g",
                header="rate_dimensionless,growth_rate,phi_j_mean,phi_j_std,z_mean,z_std,"
                       "rattler_fraction,seeds", comments="")
     (out_dir / f"{NAME}.txt").write_text(yaml.safe_dump({
         "one size (rate Γ, φ_J, final |Ψ6|) per run": [
-            [round(float(r[0]), 6), round(float(r[1]), 4), round(float(r[6][-1]), 3)]
-            for r in one_size],
+            [round(float(p.relative_rate), 6), round(float(p.jammed), 4),
+             round(float(p.order[-1]), 3)] for p in one_size],
         "mixture at the slowest rate (φ_J, final |Ψ6|) per run": [
-            [round(float(r[1]), 4), round(float(r[6][-1]), 3)] for r in slowest]}))
+            [round(float(p.jammed), 4), round(float(p.order[-1]), 3)] for p in slowest]}))
     return save(fig, out_dir, NAME)

@@ -395,6 +395,7 @@ def compressed(radius, box=(1.0, 1.0), region=None, periodic=(False, False), see
     have a gap ≥ 0 at the radii asked). No lattice is ever made. A packing the disks jam
     before reaching (a :class:`PlacementError` naming ``radius``), and one above π/√12 for
     disks of one size, cannot be made. Deterministic in ``seed``."""
+    from sim.effects.growth import growth_rate
     from sim.engine.core import Engine
     from sim.engine.inputs import Boundary
     from sim.engine.running import CLOSE_PACKING
@@ -420,7 +421,7 @@ def compressed(radius, box=(1.0, 1.0), region=None, periodic=(False, False), see
     # then runs the compiled loop of the compress scene (two species), not one of its own
     engine = Engine(position - lo, velocity, start, mass, np.arange(n) % 2,
                     boundary=Boundary(size=tuple(float(x) for x in hi - lo), periodic=wraps),
-                    growth_rate=rate / (2.0 * float(np.mean(start))))
+                    growth_rate=growth_rate(rate, start, 1.0))
     target = phi * (1.0 + 8.0 * np.finfo(float).eps)
     reason = engine.run(packing_fraction=target)
     if reason != "packing_fraction":

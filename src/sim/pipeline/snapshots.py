@@ -80,8 +80,9 @@ def advance(engine, cfg, writer, last_time, started, interruption):
                 time=None if t_stop == math.inf else t_stop,
                 energy_fraction=stop.energy_fraction, packing_fraction=stop.packing_fraction,
                 jamming=stop.jamming, wall_seconds=budget(), until=until)
-            snapshot_time = {"time": t_stop, "packing_fraction": engine.packing_fraction_time(
-                stop.packing_fraction) if reason == "packing_fraction" else None}.get(reason)
+            snapshot_time = (t_stop if reason == "time"
+                             else engine.packing_fraction_time(stop.packing_fraction)
+                             if reason == "packing_fraction" else None)
             last_time = engine.time if snapshot_time is None else snapshot_time
             met = {"collisions": stop.collisions is not None
                    and engine.collisions >= stop.collisions,
