@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 # the results the docs and the README include; only the targets below write them
 RESULTS := docs/results
 
-.PHONY: help venv run test validate tutorials bench speed figures accuracy dsmc readme docs lint wheel clean
+.PHONY: help venv run test validate tutorials bench speed figures accuracy melting dsmc readme docs lint wheel clean
 
 help:  ## list the targets
 	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
@@ -48,6 +48,9 @@ figures: $(STAMP)  ## every figure into outputs/figures/, their web versions and
 accuracy: $(STAMP)  ## accuracy against wall time for every knob into outputs/accuracy_cost/ and docs/results/ (QUICK=1: fewer settings, not copied)
 	$(PY) experiments/accuracy_cost/study.py $(if $(QUICK),--quick)
 	$(if $(QUICK),,cp outputs/accuracy_cost/summary.md $(RESULTS)/accuracy.md)
+
+melting: $(STAMP)  ## the equation of state through melting at the published sizes, into docs/results/ (hours of CPU, resumable: stopped, run it again; QUICK=1: a smoke run into outputs/)
+	$(PY) experiments/melting/study.py $(if $(QUICK),--quick --out outputs/melting_quick --results outputs/melting_quick/results,--results $(RESULTS))
 
 dsmc: $(STAMP)  ## the cooling states of rough disks by DSMC, the validation table's references, into docs/results/
 	$(PY) -m sim.checks.dsmc --out $(RESULTS)/dsmc.json

@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from sim.analysis.equation_of_state import blocking, pressure_area, reduced_pressure_d2
+from sim.analysis.equation_of_state import (
+    block_pressures,
+    blocking,
+    equilibration_cut,
+    pressure_area,
+    reduced_pressure_d2,
+    run_pressure,
+)
 
 
 def test_the_pressure_of_a_synthetic_log_and_the_naive_forms():
@@ -54,3 +61,44 @@ def test_blocking_finds_the_error_of_a_correlated_series():
     assert converged
     assert error == pytest.approx(exact, rel=0.15)
     assert errors[0] < 0.4 * exact
+
+
+def test_the_equilibration_cut_drops_a_drift_and_keeps_a_stationary_series():
+    """MSER: a relaxation over the first 50 of 1000 entries is cut within a few entries of
+    its end; white noise loses at most a few per cent of its entries."""
+    rng = np.random.default_rng(7)
+    noise = rng.normal(0.0, 0.1, 1000)
+    relaxing = noise + np.where(np.arange(1000) < 50, 2.0 * (1.0 - np.arange(1000) / 50), 0.0)
+    assert 40 <= equilibration_cut(relaxing) <= 60
+    assert equilibration_cut(noise) <= 30
+    ramp = np.linspace(1.0, 0.0, 64)  # a drift all through: at most half is dropped
+    assert equilibration_cut(ramp) == 32
+
+
+def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
+    """A short melting run: one block per snapshot interval, the formula's value from the
+    run file's virial and time, and a run that does not start at zero momentum refused."""
+    from sim.analysis.datasets import open_run
+    from sim.analysis.theory import kolafa_rottner_z
+    from sim.pipeline.run_cache import compose_config
+    from sim.pipeline.runner import run
+
+    overrides = ["scenario=melting", "disks.n=72", "disks.packing_fraction=0.6",
+                 "stop.collisions=144000", "output.every_collisions=3600",
+                 "output.progress=false"]
+    with open_run(run(compose_config(overrides), tmp_path / "a")) as data:
+        pressure, collisions = block_pressures(data)
+        assert pressure.size == 40 and np.all(np.diff(collisions) == 3600)
+        k = 5
+        expected = reduced_pressure_d2(
+            72, float(data["kinetic_energy"][0]),
+            float(data["collision_virial"][k + 1] - data["collision_virial"][k]),
+            float(data["time"][k + 1] - data["time"][k]), 1.0, 2.0 * float(data["radius"][0]))
+        assert pressure[k] == pytest.approx(expected, rel=1e-13)
+        point = run_pressure(data)
+        assert point.cut + point.blocks == 40
+        z = kolafa_rottner_z(0.6)  # βP/ρ, and ρ d² = 4φ/π
+        assert point.mean == pytest.approx(z * 4.0 * 0.6 / math.pi, rel=0.02)
+    drifting = run(compose_config([*overrides, "disks.zero_momentum=false"]), tmp_path / "b")
+    with open_run(drifting) as data, pytest.raises(ValueError, match="total momentum"):
+        block_pressures(data)

@@ -2,10 +2,18 @@
 published, and a short run of the study's state point (its long run is the validation row
 ``melting_small_n``)."""
 
+import csv
+import importlib.util
+from pathlib import Path
+
+import h5py
 import numpy as np
 import pytest
 
-from sim.checks.melting import reference, state_point
+from sim.checks.melting import loop_extrema, reference, state_point
+from sim.pipeline.interruption import Interruption
+from sim.pipeline.run_cache import compose_config
+from sim.pipeline.runner import run
 
 
 def test_the_published_pressures_are_read_per_size_and_box():
@@ -19,6 +27,17 @@ def test_the_published_pressures_are_read_per_size_and_box():
         reference(100, "1:1")
 
 
+def test_the_loop_of_a_published_curve_and_none_where_it_is_monotone():
+    """N = 224 in its square box: the maximum near φ = 0.692 and the minimum near 0.705
+    (Li et al. 2022), with errors far below the grid's 0.002; N = 72 has none."""
+    extrema = loop_extrema(*reference(224, "1:1")[:3])
+    phi_max, phi_max_error, p_max, _ = extrema["max"]
+    phi_min, phi_min_error, p_min, _ = extrema["min"]
+    assert 0.691 < phi_max < 0.693 and 0.703 < phi_min < 0.708 and p_min < p_max
+    assert phi_max_error < 5e-4 and phi_min_error < 1e-3
+    assert loop_extrema(*reference(72, "1:1")[:3]) is None
+
+
 def test_a_short_run_of_a_state_point_is_near_the_published_pressure():
     """N = 72 in its square box at φ = 0.65, 4000 collisions per disk: within 1 % of
     Li et al.'s value (the validation row runs it to an error of 0.002)."""
@@ -26,3 +45,50 @@ def test_a_short_run_of_a_state_point_is_near_the_published_pressure():
     mean, error, _, per_disk = state_point(72, aspect, 0.65, collisions=4000, blocks=64)
     assert per_disk == pytest.approx(4100, rel=0.01)
     assert abs(mean - pressure[0]) < 0.01 * pressure[0] and error < 0.05
+
+
+STUDY = Path(__file__).parents[1] / "experiments" / "melting" / "study.py"
+
+
+def _study():
+    spec = importlib.util.spec_from_file_location("melting_study", STUDY)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_twice(
+        tmp_path, monkeypatch, capsys):
+    """make melting's smoke run (--quick: N = 72 at two φ): a point interrupted after its
+    first chunk is resumed, not begun again, and ends on the bits of a study never
+    interrupted; a second study with every point done runs nothing and rewrites no run."""
+    study = _study()
+    first = study.points(study.QUICK, tmp_path / "cut")[0]
+    with monkeypatch.context() as patch:  # a signal before the first chunk ends
+        patch.setattr(Interruption, "requested", property(lambda self: True))
+        patch.setattr(Interruption, "reason", property(lambda self: "interrupted"))
+        run(compose_config(first.overrides(first.group.first)), first.folder)
+    with h5py.File(first.folder / "run.h5") as f:
+        assert f["observables/collisions/value"][-1] < first.group.first * first.group.n
+    for out in ("cut", "whole"):
+        assert study.main(["--quick", "--jobs", "1", "--out", str(tmp_path / out),
+                           "--results", str(tmp_path / out / "results")]) == 0
+    for point in study.points(study.QUICK, tmp_path / "cut"):
+        whole = tmp_path / "whole" / point.folder.relative_to(tmp_path / "cut") / "run.h5"
+        with h5py.File(point.folder / "run.h5") as a, h5py.File(whole) as b:
+            for name in ("particles/disks/position/value", "observables/collision_virial/value"):
+                assert np.array_equal(a[name][-1], b[name][-1])
+    with open(tmp_path / "whole" / "results" / "melting.csv", encoding="utf-8") as file:
+        rows = list(csv.DictReader(file))
+    assert [r["phi"] for r in rows] == ["0.650", "0.700"]
+    assert set(rows[0]) == {"n", "aspect", "phi", "start", "collisions_per_disk", "bPd2",
+                            "err", "psi6"}
+    published = reference(72, "1:1")[1]
+    assert abs(float(rows[0]["bPd2"]) - published[0]) < 5 * float(rows[0]["err"]) + 0.01
+    files = sorted((tmp_path / "whole" / "runs").glob("*/run.h5"))
+    stamps = [f.stat().st_mtime_ns for f in files]
+    capsys.readouterr()
+    assert study.main(["--quick", "--jobs", "1", "--out", str(tmp_path / "whole"),
+                       "--results", str(tmp_path / "whole" / "results")]) == 0
+    assert "a round" not in capsys.readouterr().out
+    assert [f.stat().st_mtime_ns for f in files] == stamps

@@ -23,6 +23,7 @@ with at least :data:`MIN_BLOCKS` blocks, flagged as not converged).
 """
 
 import math
+from collections import namedtuple
 
 import numpy as np
 
@@ -50,7 +51,8 @@ def blocking(series):
     level beyond which no level's error exceeds it by more than twice that level's own
     error (a standard error from b blocks is uncertain by about 1/√(2(b − 1)) of itself),
     else the largest of all levels of at least :data:`MIN_BLOCKS` blocks, with ``converged``
-    False."""
+    False; a series shorter than :data:`MIN_BLOCKS` (at least two entries) has only its naive
+    error, not converged."""
     x = np.asarray(series, np.float64)
     mean = float(x.mean())
     errors, counts = [], []
@@ -58,6 +60,8 @@ def blocking(series):
         errors.append(float(x.std(ddof=1) / math.sqrt(x.size)))
         counts.append(x.size)
         x = 0.5 * (x[: x.size // 2 * 2: 2] + x[1: x.size // 2 * 2: 2])
+    if not errors:  # too few to block: the naive error, flagged
+        return mean, float(x.std(ddof=1) / math.sqrt(x.size)), False, np.array([])
     errors, counts = np.array(errors), np.array(counts)
     uncertain = errors / np.sqrt(2.0 * (counts - 1))
     for level in range(len(errors) - 1):
@@ -65,3 +69,69 @@ def blocking(series):
         if np.all(errors[later] - errors[level] <= 2.0 * uncertain[later]):
             return mean, float(errors[level]), True, errors
     return mean, float(errors.max(initial=math.nan)), False, errors
+
+
+def equilibration_cut(series):
+    """The number of leading entries of ``series`` float64[m] to drop as equilibration: the
+    marginal standard error rule (MSER; White, Simulation 69, 323 (1997)), the d ≤ m/2 that
+    minimises Σ_{i ≥ d} (x_i − x̄_d)² / (m − d)², the squared standard error of the mean of
+    what is kept were it uncorrelated. A drift at the start raises the sum more than
+    dropping its entries costs; a stationary series keeps nearly all of its entries."""
+    x = np.asarray(series, np.float64)
+    m = x.size
+    kept = m - np.arange(m // 2 + 1)
+    tail = x[::-1]
+    mean = np.cumsum(tail)[kept - 1] / kept  # x̄_d over x[d:]
+    squares = np.cumsum(tail * tail)[kept - 1]
+    return int(np.argmin((squares - kept * mean * mean) / kept**2))
+
+
+def block_pressures(run):
+    """βP d² (:func:`reduced_pressure_d2`) of every interval between two snapshots of the
+    run Dataset ``run`` (:func:`sim.analysis.datasets.open_run`) of equal elastic disks in a
+    periodic box: float64[m], from the collision virial and time at the snapshots, and the
+    collisions at each interval's end int64[m]. Intervals of the run's snapshot cadence
+    only (the most common count of collisions between snapshots; a shorter last one is
+    dropped). Raises ValueError for disks of several sizes or masses, a run with walls,
+    kinetic energy that changes or a total momentum that is not zero at the start."""
+    radius, mass = run["radius"].values, run["mass"].values
+    if np.ptp(radius) or np.ptp(mass) or tuple(run.attrs["boundary"]) != ("periodic",) * 2:
+        raise ValueError("the pressure of equal disks in a periodic box, not of this run")
+    momentum = (mass[:, None] * run["velocity"].isel(time=0).values).sum(axis=0)
+    kinetic = run["kinetic_energy"].values
+    if np.hypot(*momentum) > 1e-9 * math.sqrt(2.0 * kinetic[0] * mass.sum()):
+        raise ValueError(f"a total momentum of zero at the start, not {momentum}")
+    if np.ptp(kinetic) > 1e-9 * kinetic[0]:
+        raise ValueError("a constant kinetic energy (an elastic run)")
+    collisions = run["collisions"].values
+    steps = np.diff(collisions)
+    cadence = np.bincount(steps).argmax() if steps.size else 0
+    whole = steps == cadence
+    area = float(np.prod(run.attrs["box"]))
+    pressure = reduced_pressure_d2(radius.size, kinetic[0],
+                                   np.diff(run["collision_virial"].values)[whole],
+                                   np.diff(run["time"].values)[whole], area, 2.0 * radius[0])
+    return pressure, collisions[1:][whole]
+
+
+EquationOfStatePoint = namedtuple(
+    "EquationOfStatePoint", "mean error converged cut blocks drift")
+EquationOfStatePoint.__doc__ = """βP d² of a run: the ``mean`` and blocking ``error`` over its
+production blocks (``converged`` as :func:`blocking` says), the ``cut`` equilibration blocks
+dropped (:func:`equilibration_cut`), the ``blocks`` kept, and the ``drift``: the difference of
+the means of the production's second and first halves over its standard error (blocking
+errors of the halves), below 3 for a run whose averages no longer drift."""
+
+
+def run_pressure(run):
+    """The :class:`EquationOfStatePoint` of the run Dataset ``run`` (:func:`block_pressures`)."""
+    pressure, _ = block_pressures(run)
+    if pressure.size < 2 * MIN_BLOCKS:
+        raise ValueError(f"at least {2 * MIN_BLOCKS} blocks of pressure, not {pressure.size}")
+    cut = equilibration_cut(pressure)
+    production = pressure[cut:]
+    mean, error, converged, _ = blocking(production)
+    half = production.size // 2
+    first, second = blocking(production[:half]), blocking(production[half:])
+    drift = (second[0] - first[0]) / math.hypot(first[1], second[1])
+    return EquationOfStatePoint(mean, error, converged, cut, production.size, float(drift))

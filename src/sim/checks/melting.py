@@ -23,14 +23,23 @@ from sim.engine import Boundary, Engine
 from sim.pipeline.initial import compressed, maxwellian, random_sequential, remove_drift
 
 REFERENCE = Path(__file__).with_name("data") / "li_2022.csv"
+#: Engel, Anderson, Glotzer, Isobe, Bernard & Krauth, Phys. Rev. E 87, 042134 (2013): event-
+#: driven MD and MPMC at N = 256², 512², MPMC at 1024², square boxes
+LARGE_N_REFERENCE = Path(__file__).with_name("data") / "engel_2013.csv"
+#: the large-N curves drawn beside a study for orientation: (label, file, N, method)
+LARGE_N = (("Engel et al. 2013, EDMD, N = 256²", LARGE_N_REFERENCE, 65536, "EDMD"),
+           ("Engel et al. 2013, EDMD, N = 512²", LARGE_N_REFERENCE, 262144, "EDMD"),
+           ("Engel et al. 2013, MPMC, N = 1024²", LARGE_N_REFERENCE, 1048576, "MPMC"))
 
 
-def reference(n, box):
+def reference(n, box, source=REFERENCE, method=None):
     """The published (φ, βP d², error) float64 arrays of ``n`` disks in the box ``box`` (as
-    ``data/li_2022.csv`` names it: ``"1:1"``, ``"9:8√3/2"``, …) and its aspect ratio."""
-    with open(REFERENCE, encoding="utf-8") as file:
+    the data files name it: ``"1:1"``, ``"9:8√3/2"``, …) and its aspect ratio, from
+    ``source`` (Li et al. 2022 unless given), of ``method`` if given."""
+    with open(source, encoding="utf-8") as file:
         rows = [row for row in csv.DictReader(line for line in file if not line.startswith("#"))
-                if int(row["n"]) == n and row["box"] == box]
+                if int(row["n"]) == n and row["box"] == box
+                and method in (None, row["method"])]
     if not rows:
         raise ValueError(f"no published pressures of N = {n} in the box {box}")
     values = np.array([[float(row[k]) for k in ("packing_fraction", "pressure_d2", "error")]
@@ -81,3 +90,36 @@ def small_n_pressure(n=72, box="1:1", phis=(0.65,), seed=0, collisions=300_000):
             "Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth 2022 (ECMC)",
             time.perf_counter() - started if not rows else None))
     return rows
+
+
+def loop_extrema(phi, pressure, error, draws=2000, seed=0):
+    """The maximum and the minimum of a van der Waals loop through the points (``phi``,
+    ``pressure`` ± ``error``, float64[m] in increasing φ): {"max": (φ, σ_φ, p, σ_p), "min":
+    (…)} from a parabola fitted (weighted by 1/error²) to the five points about each
+    extreme point, with errors as the spread over ``draws`` resamplings of the points within
+    their errors; None when the points do not rise, fall and rise again."""
+    phi, pressure, error = (np.asarray(x, np.float64) for x in (phi, pressure, error))
+    inner = np.arange(1, phi.size - 1)
+    peaks = inner[(pressure[inner] > pressure[inner - 1]) & (pressure[inner] > pressure[inner + 1])]
+    if peaks.size == 0:
+        return None
+    top = int(peaks[0])
+    dips = inner[(inner > top) & (pressure[inner] < pressure[inner - 1])
+                 & (pressure[inner] < pressure[inner + 1])]
+    if dips.size == 0:
+        return None
+    rng = np.random.default_rng(seed)
+    samples = pressure + error * rng.standard_normal((draws, phi.size))
+    extrema = {}
+    for name, k in (("max", top), ("min", int(dips[0]))):
+        near = slice(max(k - 2, 0), min(k + 3, phi.size))
+        x = phi[near] - phi[k]
+        vertices = []
+        for y in (pressure[near], *samples[:, near]):
+            c2, c1, c0 = np.polyfit(x, y, 2, w=1.0 / error[near])
+            at = -c1 / (2.0 * c2) if c2 != 0 else 0.0
+            vertices.append((phi[k] + at, c0 + c1 * at + c2 * at * at))
+        vertices = np.array(vertices)
+        spread = vertices[1:].std(axis=0)
+        extrema[name] = (vertices[0, 0], spread[0], vertices[0, 1], spread[1])
+    return extrema

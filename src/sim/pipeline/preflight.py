@@ -6,6 +6,7 @@ and an exit status (:mod:`sim.pipeline.cli_exits`)."""
 import os
 from pathlib import Path
 
+from hydra.errors import MissingConfigException
 from omegaconf import OmegaConf
 from omegaconf.errors import KeyValidationError, ValidationError
 
@@ -36,8 +37,8 @@ from sim.storage.errors import RunFileError
 
 def _type_error(error):
     """A value of the wrong type, as a :class:`ConfigError` naming the key (or None)."""
-    while error.__cause__ is not None:
-        error = error.__cause__
+    while not isinstance(error, ValidationError) and (error.__cause__ or error.__context__):
+        error = error.__cause__ or error.__context__  # Hydra raises inside its except
     key = getattr(error, "full_key", None)
     if not isinstance(error, ValidationError) or isinstance(error, KeyValidationError) \
             or not key:
@@ -104,7 +105,8 @@ def check_command_line(args):
                 explanation = _explain_key(combination)
             except Exception:
                 explanation = None
-            if explanation is None and "scenario/" in str(error):
+            if explanation is None and isinstance(error, MissingConfigException) \
+                    and "scenario/" in str(error):
                 names = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
                 explanation = (f"{' '.join(c for c in combination if 'scenario' in c)}: no "
                                f"such scenario; allowed: {', '.join(names)}")

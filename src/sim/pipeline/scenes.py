@@ -492,6 +492,7 @@ SCENES = {spec.name: spec for spec in (
               sections=("compress",), check=_check_compress, gas_like=True),
     SceneSpec("crater", crater, _crater_count, preparation=_crater_preparation,
               sections=("projectile", "bed"), check=_check_crater, packing_fraction=_bed_packing),
+    SceneSpec("melting", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("driven", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("rough_cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),

@@ -1,0 +1,462 @@
+"""The melting of hard disks: the equation of state βP d² through liquid–hexatic coexistence
+at the sizes and in the boxes of the published references, run to the errors they ask for.
+
+Every state point of :data:`PLAN` is one run of the ``melting`` scene in a folder of its own
+under ``--out`` (``runs/<n>-<box>-<φ>-<start>/run.h5``), which also keeps the point's
+analysis (``point.json``). A point is run in rounds: the first runs ``first`` collisions per
+disk; after each, :func:`sim.analysis.equation_of_state.run_pressure` drops the equilibration
+blocks by the MSER rule and finds the blocking error of the rest, and the point is done when
+that error is at most the group's ``target``, the blocking has converged and the means of the
+production's two halves agree within 3 standard errors. Otherwise it is resumed to the length
+its error asks for (:func:`next_length`), at most ``longest`` collisions per disk; a point
+that reaches it is reported as missing its target. The rounds' runs go to joblib's worker
+processes (``--jobs``), or with ``--cluster slurm`` to SLURM through submitit, a job per run.
+
+Interrupted (Ctrl-C, a killed job, the end of a session), the study starts again where it
+was: a run resumes from its last checkpoint (written every 30 s of wall time and at every
+stop), a finished point is not run again, and a second ``make melting`` with every point done
+only reads the analyses and draws. The processor time of every round is added up per point.
+
+Writes into ``--results`` (``make melting``: docs/results/): ``melting.csv`` (one row per run:
+n, aspect, phi, start, collisions_per_disk, bPd2, err, psi6), ``melting_reference.csv`` (the
+published value of each row's N, box and φ with its source), ``melting.json`` (per point the
+whole analysis and processor seconds; per group the published loop's extrema and ours),
+``melting_eos.png`` and ``melting_psi6.png``.
+
+    python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--quick]
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib import pyplot as plt
+
+from sim.analysis.datasets import global_bond_order, open_run
+from sim.analysis.equation_of_state import run_pressure
+from sim.analysis.packing import orientational_correlation
+from sim.checks.melting import LARGE_N, loop_extrema, reference
+from sim.figures.style import draw_disks
+from sim.pipeline.resume import resume, stored_config
+from sim.pipeline.run_cache import compose_config
+from sim.pipeline.runner import run
+
+#: the drift of the production's halves, in standard errors, below which a run is stationary
+DRIFT = 3.0
+#: a round resumes a point to this many times the length its error asks for
+MARGIN = 1.3
+#: and to at least 1.5, at most 4 times its length so far
+GROWTH = (1.5, 4.0)
+#: the fewest production blocks of a point done: blocking has three levels of 8 and more
+PRODUCTION_BLOCKS = 64
+
+
+@dataclass(frozen=True)
+class Group:
+    """State points of one N and box: ``phis`` (published packing fractions), started as
+    ``start`` (``compressed``: a random gas compressed by growing disks; ``melted``: a
+    hexagonal lattice melted by ten collisions per disk); a snapshot, one block of the
+    pressure, every ``block`` collisions per disk; ``first`` collisions per disk in the first
+    round, at most ``longest``; done at an error of βP d² of at most ``target``."""
+
+    name: str
+    n: int
+    box: str
+    phis: tuple
+    start: str
+    block: int
+    first: int
+    longest: int
+    target: float
+
+
+#: the published sizes and boxes (Li et al. 2022), with the published points dense where the
+#: curves bend; N = 128² at the points of its MPMC data, the loop's maximum (0.704) and
+#: minimum (0.716) from both starts
+PLAN = (
+    Group("72-square", 72, "1:1", (0.650, 0.660, 0.670, 0.680, 0.686, 0.690, 0.694, 0.698,
+                                   0.702, 0.706, 0.710, 0.720),
+          "compressed", 1000, 1_000_000, 30_000_000, 0.002),
+    Group("72-lattice", 72, "9:8√3/2", (0.650, 0.670, 0.680, 0.684, 0.686, 0.688, 0.690,
+                                        0.692, 0.694, 0.696, 0.698, 0.700, 0.706, 0.720),
+          "compressed", 1000, 1_000_000, 30_000_000, 0.002),
+    Group("224-square", 224, "1:1", (0.670, 0.680, 0.686, 0.690, 0.692, 0.694, 0.698, 0.702,
+                                     0.704, 0.706, 0.708, 0.712, 0.720),
+          "compressed", 500, 300_000, 10_000_000, 0.003),
+    Group("870-square", 870, "1:1", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706, 0.710,
+                                     0.712, 0.714, 0.716, 0.718),
+          "compressed", 200, 100_000, 3_000_000, 0.003),
+    Group("870-lattice", 870, "29:30√3/2", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706,
+                                            0.710, 0.712, 0.714, 0.716, 0.718),
+          "compressed", 200, 100_000, 3_000_000, 0.003),
+    Group("16384-square", 16384, "1:1", (0.698, 0.704, 0.708, 0.712, 0.716),
+          "compressed", 1000, 80_000, 400_000, 0.003),
+    Group("16384-square-melted", 16384, "1:1", (0.704, 0.716),
+          "melted", 1000, 80_000, 400_000, 0.003),
+)
+
+#: a smoke run of the study: two points of N = 72, short, into a folder of the caller's
+QUICK = (Group("72-square", 72, "1:1", (0.650, 0.700), "compressed", 500, 10_000, 20_000,
+               0.05),)
+
+
+@dataclass(frozen=True)
+class Point:
+    """One state point: its group and packing fraction, and its run folder."""
+
+    group: Group
+    phi: float
+    folder: Path
+
+    @property
+    def aspect(self):
+        return reference(self.group.n, self.group.box)[3]
+
+    def overrides(self, collisions_per_disk):
+        g = self.group
+        return ["scenario=melting", f"disks.n={g.n}", f"disks.packing_fraction={self.phi}",
+                f"box.size=[{self.aspect!r},1.0]", f"disks.placement={g.start}",
+                f"stop.collisions={collisions_per_disk * g.n}",
+                f"output.every_collisions={g.block * g.n}", "output.progress=false"]
+
+
+def points(plan, out):
+    return [Point(g, phi, Path(out) / "runs" / f"{g.name}-{phi:.3f}") for g in plan
+            for phi in g.phis]
+
+
+def _record(point):
+    path = point.folder / "point.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def next_length(point, record):
+    """Collisions per disk the point runs to in its next round, or None when it is done:
+    its error at most the target, its blocking converged, no drift and at least
+    :data:`PRODUCTION_BLOCKS` blocks kept; or its longest run reached."""
+    g = point.group
+    done = (record["err"] <= g.target and record["converged"]
+            and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS)
+    if done or record["collisions_per_disk"] >= g.longest:
+        return None
+    length = record["collisions_per_disk"]
+    production = length * record["blocks"] / (record["blocks"] + record["cut"])
+    ratio = (record["err"] / g.target) ** 2 if math.isfinite(record["err"]) else math.inf
+    asked = length - production + max(production * MARGIN * ratio, PRODUCTION_BLOCKS * g.block)
+    asked = min(max(asked, GROWTH[0] * length), GROWTH[1] * length, g.longest)
+    return int(math.ceil(asked / g.block) * g.block)
+
+
+def advance(point, collisions_per_disk):
+    """Run or resume ``point`` to ``collisions_per_disk`` and analyse it; its record."""
+    started = time.process_time()
+    path = point.folder / "run.h5"
+    overrides = point.overrides(collisions_per_disk)
+    if path.exists():  # cut short, or to be run longer
+        stored, _ = stored_config(path)
+        collisions = max(stored.stop.collisions, collisions_per_disk * point.group.n)
+        resume(path, [f"stop.collisions={collisions}"])
+    else:
+        run(compose_config(overrides), point.folder, overrides=overrides)
+    return analyse(point, time.process_time() - started)
+
+
+def analyse(point, cpu_seconds=0.0):
+    """The point's record from its run file, written to its ``point.json``: βP d² and its
+    analysis (:func:`run_pressure`), the mean |Ψ₆| of the production's snapshots, the
+    processor seconds of every round so far."""
+    previous = _record(point) or {}
+    with open_run(point.folder / "run.h5") as dataset:
+        if dataset.attrs["stop_reason"] in ("interrupted", "terminated"):
+            raise KeyboardInterrupt  # a signal: the study stops, a later one goes on
+        eos = run_pressure(dataset)
+        psi = global_bond_order(dataset).values[1 + eos.cut:]
+        collisions = int(dataset["collisions"].values[-1])
+    g = point.group
+    record = {"group": g.name, "n": g.n, "box": g.box, "aspect": point.aspect,
+              "phi": point.phi, "start": g.start, "seed": 0,
+              "collisions_per_disk": collisions / g.n, "bPd2": eos.mean, "err": eos.error,
+              "converged": bool(eos.converged), "cut": eos.cut, "blocks": eos.blocks,
+              "drift": eos.drift, "psi6": float(np.mean(psi)),
+              "cpu_seconds": previous.get("cpu_seconds", 0.0) + cpu_seconds}
+    (point.folder / "point.json").write_text(json.dumps(record, indent=1))
+    return record
+
+
+def _pending(todo):
+    """(point, collisions per disk) of every point that has a round to run."""
+    rounds = []
+    for point in todo:
+        record = _record(point)
+        if record is None:
+            if (point.folder / "run.h5").exists():  # cut short before its first analysis
+                stored = stored_config(point.folder / "run.h5")[0]
+                rounds.append((point, stored.stop.collisions // point.group.n))
+            else:
+                rounds.append((point, point.group.first))
+        elif (length := next_length(point, record)) is not None:
+            rounds.append((point, length))
+    return rounds
+
+
+def _execute(rounds, jobs, cluster, out):
+    if cluster is None:
+        from joblib import Parallel, delayed
+        # no run queued beyond those running: a study whose parent is gone starts no more
+        return Parallel(n_jobs=jobs, pre_dispatch="n_jobs")(delayed(advance)(p, c)
+                                                            for p, c in rounds)
+    import submitit
+    executor = submitit.AutoExecutor(folder=Path(out) / "submitit", cluster=cluster)
+    executor.update_parameters(timeout_min=24 * 60, cpus_per_task=1)
+    jobs = executor.map_array(advance, *zip(*rounds, strict=True))
+    return [job.result() for job in jobs]
+
+
+def simulate(plan, out, jobs, cluster=None):
+    """Rounds of :func:`advance` until every point of ``plan`` is done; the longest points
+    first in every round."""
+    todo = points(plan, out)
+    while rounds := _pending(todo):
+        rounds.sort(key=lambda pc: -pc[0].group.n * pc[1])
+        print(f"melting: a round of {len(rounds)} runs, "
+              f"{sum(p.group.n * c for p, c in rounds):.3g} collisions", flush=True)
+        _execute(rounds, jobs, cluster, out)
+    return [_record(p) for p in todo]
+
+
+# ---------------------------------------------------------------------------- the results
+
+
+def write_tables(records, results):
+    """melting.csv and melting_reference.csv, one row per run."""
+    columns = ("n", "aspect", "phi", "start", "collisions_per_disk", "bPd2", "err", "psi6")
+    with open(results / "melting.csv", "w", newline="", encoding="utf-8") as file:
+        writer = csv.writer(file)
+        writer.writerow(columns)
+        for r in records:
+            writer.writerow([r["n"], f"{r['aspect']:.12g}", f"{r['phi']:.3f}", r["start"],
+                             f"{r['collisions_per_disk']:.0f}", f"{r['bPd2']:.5f}",
+                             f"{r['err']:.5f}", f"{r['psi6']:.4f}"])
+    with open(results / "melting_reference.csv", "w", newline="", encoding="utf-8") as file:
+        writer = csv.writer(file)
+        writer.writerow(("n", "box", "aspect", "phi", "bPd2", "err", "source"))
+        for r in records:
+            phi, pressure, error, _ = reference(r["n"], r["box"])
+            k = int(np.argmin(np.abs(phi - r["phi"])))
+            writer.writerow([r["n"], r["box"], f"{r['aspect']:.12g}", f"{r['phi']:.3f}",
+                             pressure[k], error[k], SOURCE])
+
+
+SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157, 234111 (2022), "
+          "data of jellyfysh/HistoricDisks")
+
+
+def extrema(records):
+    """Per group with a loop in its published curve: the published maximum and minimum
+    and ours (:func:`loop_extrema`), where our points show one."""
+    found = {}
+    for name in dict.fromkeys(r["group"] for r in records):
+        mine = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
+        published = loop_extrema(*reference(mine[0]["n"], mine[0]["box"])[:3])
+        if published is None:
+            continue
+        ours = loop_extrema(*(np.array([r[k] for r in mine]) for k in ("phi", "bPd2", "err")))
+        found[name] = {"published": published, "sim": ours}
+    return found
+
+
+#: the panels of the equation of state: (N, box) and the groups drawn in each
+PANELS = ((72, "1:1"), (72, "9:8√3/2"), (224, "1:1"), (870, "1:1"), (870, "29:30√3/2"),
+          (16384, "1:1"))
+
+
+def draw_equation_of_state(records, path):
+    """βP d² against φ per N and box: the runs with their blocking errors beside the published
+    curve of the same N and box (and, at N = 128², the large-N curves)."""
+    fig, axes = plt.subplots(2, 3, figsize=(12.0, 7.0), constrained_layout=True)
+    for ax, (n, box) in zip(axes.ravel(), PANELS, strict=True):
+        phi, pressure, error, _ = reference(n, box)
+        ax.fill_between(phi, pressure - 3 * error, pressure + 3 * error, color="0.6", alpha=0.4)
+        ax.plot(phi, pressure, color="0.3", lw=1.0, label="Li et al. 2022, same N and box")
+        if n == 16384:
+            for k, (label, source, large, method) in enumerate(LARGE_N):
+                lphi, lp, _, _ = reference(large, "1:1", source, method)
+                ax.plot(lphi, lp, color=f"C{k + 2}", lw=0.8, ls="--", label=label)
+        mine = [r for r in records if r["n"] == n and r["box"] == box]
+        for start, marker in (("compressed", "o"), ("melted", "s")):
+            rows = sorted((r for r in mine if r["start"] == start), key=lambda r: r["phi"])
+            if rows:
+                ax.errorbar([r["phi"] for r in rows], [r["bPd2"] for r in rows],
+                            [r["err"] for r in rows], fmt=marker, ms=3.5, capsize=2,
+                            mfc="none" if start == "melted" else None,
+                            label=f"sim, from a {start} start")
+        if mine:
+            lo, hi = min(r["phi"] for r in mine), max(r["phi"] for r in mine)
+            inside = (phi >= lo - 0.003) & (phi <= hi + 0.003)
+            ax.set_xlim(lo - 0.003, hi + 0.003)
+            span = [*pressure[inside], *(r["bPd2"] for r in mine)]
+            pad = 0.05 * (max(span) - min(span)) + 0.005
+            ax.set_ylim(min(span) - pad, max(span) + pad)
+        ax.set_title(f"N = {n}, box {box}", fontsize=10)
+        ax.set_xlabel("packing fraction φ")
+        ax.set_ylabel("βP d²")
+        ax.legend(fontsize=7)
+    fig.suptitle("Hard disks through melting: sim (seed 0, ±1 blocking standard error) "
+                 "against the published pressures (band: ±3 standard errors)", fontsize=10)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def draw_bond_order(points_done, path):
+    """The last snapshot of the N = 128² run nearest φ = 0.708 with every disk coloured by
+    the phase of its ψ₆, and g₆(r) of the last snapshot of every N = 128² run."""
+    large = [p for p in points_done if p.group.n == 16384 and (p.folder / "run.h5").exists()]
+    if not large:
+        return
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, 5.6), constrained_layout=True,
+                                      gridspec_kw={"width_ratios": (1.1, 1.0)})
+    shown = min(large, key=lambda p: (abs(p.phi - 0.708), p.group.start != "compressed"))
+    for point in sorted(large, key=lambda p: (p.group.start, p.phi)):
+        with open_run(point.folder / "run.h5") as run_data:
+            last = run_data.isel(time=-1)
+            position, psi = last["position"].values, last["bond_order"].values
+            radius = run_data["radius"].values
+            box = tuple(run_data.attrs["box"])
+        psi = psi[:, 0] + 1j * psi[:, 1]
+        diameter = 2.0 * radius[0]
+        r, g6 = orientational_correlation(position, psi, box, (True, True), 120, 12 * diameter)
+        right.loglog(r / diameter, np.abs(g6), lw=1.0, ls="-" if point.group.start ==
+                     "compressed" else ":", label=f"φ = {point.phi:.3f}, {point.group.start}")
+        if point == shown:
+            phase = np.angle(psi) / 6.0
+            disks = draw_disks(left, position, radius, values=phase, cmap="twilight",
+                               clim=(-np.pi / 6, np.pi / 6))
+            fig.colorbar(disks, ax=left, shrink=0.7, label="phase of ψ₆, arg(ψ₆)/6 (rad)")
+            left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[])
+            left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start, last "
+                           f"snapshot (seed 0)", fontsize=10)
+    x = np.array([1.0, 12.0])
+    right.loglog(x, x ** -0.25, color="k", lw=0.8, ls="--",
+                 label="r^(−1/4), the slowest decay of a hexatic (KTHNY)")
+    right.set(xlabel="r / d", ylabel="|g₆(r)|", ylim=(1e-2, 1.2))
+    right.set_title("Bond-orientational correlation, last snapshot of each N = 128² run",
+                    fontsize=10)
+    right.legend(fontsize=7)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def _cost(records):
+    """Processor hours per group, and what N = 256² at the points of N = 128² would cost at
+    least: four times the disks, the same collisions per disk at the rate of N = 128²."""
+    hours = {}
+    for r in records:
+        hours[r["group"]] = hours.get(r["group"], 0.0) + r["cpu_seconds"] / 3600.0
+    large = [r for r in records if r["n"] == 16384 and r["cpu_seconds"] > 0]
+    per_point = (4.0 * sum(r["cpu_seconds"] for r in large) / len(large) / 3600.0
+                 if large else None)
+    return hours, per_point
+
+
+def write_markdown(records, found, results):
+    """melting.md: every run against the published value of its N and box, the loops'
+    extrema, the processor hours."""
+    lines = []
+    for name in dict.fromkeys(r["group"] for r in records):
+        rows = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
+        phi, pressure, error, _ = reference(rows[0]["n"], rows[0]["box"])
+        lines += [f"**N = {rows[0]['n']}, box {rows[0]['box']}, {rows[0]['start']} start**",
+                  "", "| φ | βP d², sim | published | difference / combined error | "
+                  "collisions per disk | equilibration cut | drift | ⟨|Ψ₆|⟩ |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for r in rows:
+            k = int(np.argmin(np.abs(phi - r["phi"])))
+            z = (r["bPd2"] - pressure[k]) / math.hypot(r["err"], error[k])
+            lines.append(f"| {r['phi']:.3f} | {r['bPd2']:.4f} ± {r['err']:.4f} | "
+                         f"{pressure[k]:.4f} ± {error[k]:.4f} | {z:+.1f} | "
+                         f"{r['collisions_per_disk']:.3g} | {r['cut']} of "
+                         f"{r['cut'] + r['blocks']} blocks | {r['drift']:+.1f} | "
+                         f"{r['psi6']:.3f} |")
+        lines.append("")
+    if found:
+        lines += ["**The loops' extrema** (a parabola through the five points about each; "
+                  "errors from resampling the points within theirs)", "",
+                  "| N, box | maximum: published φ, βP d² | sim | minimum: published φ, "
+                  "βP d² | sim |", "| --- | --- | --- | --- | --- |"]
+
+        def extreme(e):
+            return "none in the points" if e is None else \
+                f"{e[0]:.4f} ± {e[1]:.4f}, {e[2]:.4f} ± {e[3]:.4f}"
+        for name, both in found.items():
+            sim = both["sim"] or {"max": None, "min": None}
+            lines.append(f"| {name} | {extreme(both['published']['max'])} | "
+                         f"{extreme(sim['max'])} | {extreme(both['published']['min'])} | "
+                         f"{extreme(sim['min'])} |")
+        lines.append("")
+    hours, per_point = _cost(records)
+    lines.append("Processor hours: " + "; ".join(f"{k} {v:.2f}" for k, v in hours.items())
+                 + f"; in all {sum(hours.values()):.2f}.")
+    if per_point is not None:
+        lines.append(f"N = 256² would take at least {per_point:.2f} processor hours per state "
+                     f"point (four times the disks of N = 128² at the same collisions per "
+                     f"disk; its slower relaxation would ask for more).")
+    (results / "melting.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def summarise(records, results, todo):
+    """The tables, the figures, melting.md and melting.json of the points done."""
+    records = [r for r in records if r is not None]
+    results.mkdir(parents=True, exist_ok=True)
+    write_tables(records, results)
+    found = extrema(records)
+    write_markdown(records, found, results)
+    draw_equation_of_state(records, results / "melting_eos.png")
+    draw_bond_order([p for p in todo if _record(p) is not None], results / "melting_psi6.png")
+    hours, _ = _cost(records)
+    summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
+               "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
+               "rules": {"drift": DRIFT, "margin": MARGIN, "growth": GROWTH,
+                         "production_blocks": PRODUCTION_BLOCKS}}
+    (results / "melting.json").write_text(json.dumps(summary, indent=1, default=float))
+    print(f"melting: {len(records)} points, {sum(hours.values()):.2f} processor hours, "
+          f"into {results}")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, default=Path("outputs/melting"))
+    parser.add_argument("--results", type=Path, default=Path("outputs/melting/results"))
+    parser.add_argument("--groups", nargs="*", help="names of the groups of PLAN to run")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count())
+    parser.add_argument("--cluster", choices=("slurm", "local"), default=None,
+                        help="run the rounds through submitit instead of joblib")
+    parser.add_argument("--quick", action="store_true", help="a smoke run: two short points")
+    parser.add_argument("--report", action="store_true",
+                        help="run nothing: the results of the points done so far")
+    args = parser.parse_args(argv)
+    plan = QUICK if args.quick else PLAN
+    if args.groups:
+        unknown = set(args.groups) - {g.name for g in plan}
+        if unknown:
+            parser.error(f"--groups: {', '.join(sorted(unknown))}: no such group; allowed: "
+                         + ", ".join(g.name for g in plan))
+        plan = tuple(g for g in plan if g.name in args.groups)
+    try:
+        records = ([_record(p) for p in points(plan, args.out)] if args.report
+                   else simulate(plan, args.out, args.jobs, args.cluster))
+    except KeyboardInterrupt:
+        print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
+        return 130
+    summarise(records, args.results, points(plan, args.out))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
