@@ -50,7 +50,13 @@ accuracy: $(STAMP)  ## accuracy against wall time for every knob into outputs/ac
 	$(if $(QUICK),,cp outputs/accuracy_cost/summary.md $(RESULTS)/accuracy.md)
 
 melting: $(STAMP)  ## the equation of state through melting at the published sizes, into docs/results/ (hours of CPU, resumable: stopped, run it again; QUICK=1: a smoke run into outputs/)
-	$(PY) experiments/melting/study.py $(if $(QUICK),--quick --out outputs/melting_quick --results outputs/melting_quick/results,--results $(RESULTS))
+	$(PY) experiments/melting/study.py $(if $(QUICK),--quick --out outputs/melting_quick --results outputs/melting_quick/results)
+	$(if $(QUICK),,cp outputs/melting/results/melting.csv $(RESULTS)/melting.csv)
+	$(if $(QUICK),,cp outputs/melting/results/melting_reference.csv $(RESULTS)/melting_reference.csv)
+	$(if $(QUICK),,cp outputs/melting/results/melting.md $(RESULTS)/melting.md)
+	$(if $(QUICK),,cp outputs/melting/results/melting.json $(RESULTS)/melting.json)
+	$(if $(QUICK),,cp outputs/melting/results/melting_eos.png $(RESULTS)/melting_eos.png)
+	$(if $(QUICK),,cp outputs/melting/results/melting_psi6.png $(RESULTS)/melting_psi6.png)
 
 dsmc: $(STAMP)  ## the cooling states of rough disks by DSMC, the validation table's references, into docs/results/
 	$(PY) -m sim.checks.dsmc --out $(RESULTS)/dsmc.json
@@ -59,7 +65,7 @@ bench: $(STAMP)  ## engine rate table (see benchmarks/engine_rate.py --help)
 	$(PY) benchmarks/engine_rate.py
 
 speed: $(STAMP)  ## sim beside the C code of the fastest design, in one session, into docs/results/
-	$(PY) benchmarks/peer_speed.py --n 10000 100000 1000000 --phi 0.5 \
+	$(PY) benchmarks/peer_speed.py --n 10000 100000 1000000 --phi 0.5 --state 16384:0.708 \
 		--json $(RESULTS)/speed.json --markdown $(RESULTS)/speed.md
 	$(PY) benchmarks/speed_figure.py $(RESULTS)/speed.json $(RESULTS)/speed.png
 

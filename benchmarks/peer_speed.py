@@ -16,6 +16,7 @@ PATH`` the table with a line saying where and how it was measured (``make speed`
 into ``docs/results/``, and ``speed_figure.py`` draws the JSON).
 
     python benchmarks/peer_speed.py --n 10000 100000 --phi 0.5 --rounds 6
+    python benchmarks/peer_speed.py --n 10000 --phi 0.5 --state 16384:0.708   # and a dense one
     python benchmarks/peer_speed.py --minimal --json outputs/peer_speed.json
 """
 
@@ -167,10 +168,22 @@ def machine():
             "command": shlex.join(["python", *sys.argv])}
 
 
+def state(text):
+    """``N:PHI`` as (int, float), for ``--state``."""
+    n, _, phi = text.partition(":")
+    try:
+        return int(n), float(phi)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: N:PHI, say 16384:0.708") from None
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, nargs="+", default=[10_000, 100_000, 1_000_000])
     parser.add_argument("--phi", type=float, nargs="+", default=[0.5])
+    parser.add_argument("--state", nargs="+", default=[], metavar="N:PHI", type=state,
+                        help="further states, each N disks at packing fraction PHI, after "
+                             "those of --n × --phi")
     parser.add_argument("--chunk", type=int, default=1_000_000, help="collisions per round")
     parser.add_argument("--rounds", type=int, default=8)
     parser.add_argument("--warmup", type=float, default=10.0, help="collisions per disk")
@@ -202,18 +215,17 @@ def main(argv=None):
         table = [f"| {' | '.join(header)} |", f"|{' --- |' * len(header)}"]
         print("\n".join(table))
         rows = []
-        for n in args.n:
-            for phi in args.phi:
-                row = measure(executable, folder, n, phi, args.chunk, args.rounds, args.warmup,
-                              args.shell, args.minimal)
-                rows.append(row)
-                cells = [n, phi, row["shell"], f"{row['c_collisions_per_s'] / 1e6:.3f} M"]
-                for kind in ["sim"] + (["minimal"] if args.minimal else []):
-                    cells += [f"{row[f'{kind}_collisions_per_s'] / 1e6:.3f} M",
-                              row[f"{kind}_over_c"],
-                              f"{row[f'{kind}_over_c_q1']}–{row[f'{kind}_over_c_q3']}"]
-                table.append(f"| {' | '.join(str(c) for c in cells)} |")
-                print(table[-1], flush=True)
+        for n, phi in [*((n, phi) for n in args.n for phi in args.phi), *args.state]:
+            row = measure(executable, folder, n, phi, args.chunk, args.rounds, args.warmup,
+                          args.shell, args.minimal)
+            rows.append(row)
+            cells = [n, phi, row["shell"], f"{row['c_collisions_per_s'] / 1e6:.3f} M"]
+            for kind in ["sim"] + (["minimal"] if args.minimal else []):
+                cells += [f"{row[f'{kind}_collisions_per_s'] / 1e6:.3f} M",
+                          row[f"{kind}_over_c"],
+                          f"{row[f'{kind}_over_c_q1']}–{row[f'{kind}_over_c_q3']}"]
+            table.append(f"| {' | '.join(str(c) for c in cells)} |")
+            print(table[-1], flush=True)
     about = machine()
     note = (f"Rates: the best chunk of {args.rounds} rounds of {args.chunk} collisions, one "
             f"thread; ratios: median and quartiles over rounds of the same-round ratio. "

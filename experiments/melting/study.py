@@ -38,15 +38,20 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib import pyplot as plt
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import Normalize
+from PIL import Image
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
 from sim.analysis.packing import orientational_correlation
 from sim.checks.melting import LARGE_N, loop_extrema, reference
 from sim.figures.style import draw_disks
+from sim.figures.web import web_png
 from sim.pipeline.resume import resume, stored_config
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
+from sim.storage.errors import RunFileError
 
 #: the drift of the production's halves, in standard errors, below which a run is stationary
 DRIFT = 3.0
@@ -272,12 +277,27 @@ def extrema(records):
     return found
 
 
+#: the packing fraction of the snapshot drawn, inside the coexistence of N = 128²
+COEXISTENCE = 0.708
+
 #: the panels of the equation of state: (N, box) and the groups drawn in each
 PANELS = ((72, "1:1"), (72, "9:8√3/2"), (224, "1:1"), (870, "1:1"), (870, "29:30√3/2"),
           (16384, "1:1"))
 
 
-def draw_equation_of_state(records, path):
+def publish(fig, name, out, results):
+    """``name``.png and .pdf into ``out``/figures, and the web version (``web_png``: at most
+    ``sim.figures.web.LARGEST_IMAGE`` bytes) into ``results``."""
+    folder = Path(out) / "figures"
+    folder.mkdir(parents=True, exist_ok=True)
+    fig.savefig(folder / f"{name}.png", dpi=150)
+    fig.savefig(folder / f"{name}.pdf")
+    plt.close(fig)
+    with Image.open(folder / f"{name}.png") as image:
+        (results / f"{name}.png").write_bytes(web_png(image))
+
+
+def draw_equation_of_state(records, out, results):
     """βP d² against φ per N and box: the runs with their blocking errors beside the published
     curve of the same N and box (and, at N = 128², the large-N curves)."""
     fig, axes = plt.subplots(2, 3, figsize=(12.0, 7.0), constrained_layout=True)
@@ -310,11 +330,10 @@ def draw_equation_of_state(records, path):
         ax.legend(fontsize=7)
     fig.suptitle("Hard disks through melting: sim (seed 0, ±1 blocking standard error) "
                  "against the published pressures (band: ±3 standard errors)", fontsize=10)
-    fig.savefig(path)
-    plt.close(fig)
+    publish(fig, "melting_eos", out, results)
 
 
-def draw_bond_order(points_done, path):
+def draw_bond_order(points_done, out, results):
     """The last snapshot of the N = 128² run nearest φ = 0.708 with every disk coloured by
     the phase of its ψ₆, and g₆(r) of the last snapshot of every N = 128² run."""
     large = [p for p in points_done if p.group.n == 16384 and (p.folder / "run.h5").exists()]
@@ -322,9 +341,13 @@ def draw_bond_order(points_done, path):
         return
     fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, 5.6), constrained_layout=True,
                                       gridspec_kw={"width_ratios": (1.1, 1.0)})
-    shown = min(large, key=lambda p: (abs(p.phi - 0.708), p.group.start != "compressed"))
+    shown = min(large, key=lambda p: (abs(p.phi - COEXISTENCE), p.group.start != "compressed"))
     for point in sorted(large, key=lambda p: (p.group.start, p.phi)):
-        with open_run(point.folder / "run.h5") as run_data:
+        try:
+            run_data = open_run(point.folder / "run.h5")
+        except RunFileError:  # --report while the study runs it on
+            continue
+        with run_data:
             last = run_data.isel(time=-1)
             position, psi = last["position"].values, last["bond_order"].values
             radius = run_data["radius"].values
@@ -335,10 +358,13 @@ def draw_bond_order(points_done, path):
         right.loglog(r / diameter, np.abs(g6), lw=1.0, ls="-" if point.group.start ==
                      "compressed" else ":", label=f"φ = {point.phi:.3f}, {point.group.start}")
         if point == shown:
-            phase = np.angle(psi) / 6.0
-            disks = draw_disks(left, position, radius, values=phase, cmap="twilight",
-                               clim=(-np.pi / 6, np.pi / 6))
-            fig.colorbar(disks, ax=left, shrink=0.7, label="phase of ψ₆, arg(ψ₆)/6 (rad)")
+            angle = Normalize(-np.pi / 6, np.pi / 6)
+            hue = plt.get_cmap("hsv")(angle(np.angle(psi) / 6.0))
+            hue[:, :3] *= np.clip(np.abs(psi), 0.0, 1.0)[:, None]  # a liquid's disks dark
+            draw_disks(left, position, radius, colors=hue)
+            fig.colorbar(ScalarMappable(angle, "hsv"), ax=left, shrink=0.7,
+                         label="orientation of the local hexagon, arg(ψ₆)/6 (rad); "
+                               "brightness |ψ₆|")
             left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[])
             left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start, last "
                            f"snapshot (seed 0)", fontsize=10)
@@ -349,8 +375,7 @@ def draw_bond_order(points_done, path):
     right.set_title("Bond-orientational correlation, last snapshot of each N = 128² run",
                     fontsize=10)
     right.legend(fontsize=7)
-    fig.savefig(path)
-    plt.close(fig)
+    publish(fig, "melting_psi6", out, results)
 
 
 def _cost(records):
@@ -368,7 +393,14 @@ def _cost(records):
 def write_markdown(records, found, results):
     """melting.md: every run against the published value of its N and box, the loops'
     extrema, the processor hours."""
-    lines = []
+    lines = [f"A point is done when the blocking error of βP d² over its production is at "
+             f"most its group's target, the blocking has converged, the means of the "
+             f"production's halves differ by less than {DRIFT:g} standard errors and at "
+             f"least {PRODUCTION_BLOCKS} blocks are kept; else it runs on to {MARGIN:g} times "
+             f"the length its error asks for ({GROWTH[0]:g} to {GROWTH[1]:g} times its "
+             f"length so far). Targets: "
+             + "; ".join(f"{g.name} {g.target:g} (a block every {g.block} collisions per "
+                         f"disk, at most {g.longest:.3g})" for g in PLAN) + ".", ""]
     for name in dict.fromkeys(r["group"] for r in records):
         rows = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
         phi, pressure, error, _ = reference(rows[0]["n"], rows[0]["box"])
@@ -410,15 +442,15 @@ def write_markdown(records, found, results):
     (results / "melting.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
-def summarise(records, results, todo):
+def summarise(records, out, results, todo):
     """The tables, the figures, melting.md and melting.json of the points done."""
     records = [r for r in records if r is not None]
     results.mkdir(parents=True, exist_ok=True)
     write_tables(records, results)
     found = extrema(records)
     write_markdown(records, found, results)
-    draw_equation_of_state(records, results / "melting_eos.png")
-    draw_bond_order([p for p in todo if _record(p) is not None], results / "melting_psi6.png")
+    draw_equation_of_state(records, out, results)
+    draw_bond_order([p for p in todo if _record(p) is not None], out, results)
     hours, _ = _cost(records)
     summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
@@ -454,7 +486,7 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
         return 130
-    summarise(records, args.results, points(plan, args.out))
+    summarise(records, args.out, args.results, points(plan, args.out))
     return 0
 
 
