@@ -119,3 +119,46 @@ def test_a_jammed_packing_is_isostatic_on_its_plateau():
     assert np.ptp(z) < 0.05
     assert 3.9 < z.mean() < 4.05
     assert 0.0 <= rattlers.mean() < 0.15
+
+
+def test_bond_order_of_a_frame_at_coexistence_agrees_with_freud_disk_by_disk(tmp_path):
+    """The last frame of the melting scene as shipped (N = 870 at φ = 0.70, inside the
+    liquid–hexatic coexistence) after 20 collisions per disk: sim's and freud's Voronoi
+    neighbours are the same for nearly every disk, and where they are, ψ₆ agrees to freud's
+    float32 round-off; the ψ₆ the observer wrote is that of the frame's positions, and g₆(r)
+    agrees with freud's on the same frame."""
+    from sim.analysis.datasets import open_run
+    from sim.analysis.packing import voronoi_neighbours
+    from sim.pipeline.runner import run
+
+    cfg = compose_scene("melting", "stop.collisions=17400", "output.every_collisions=8700")
+    with open_run(run(cfg, tmp_path)) as data:
+        last = data.isel(time=-1)
+        position, stored = last["position"].values, last["bond_order"].values
+        box = tuple(data.attrs["box"])
+    psi = bond_order(position, box, (True, True))
+    assert np.array_equal(stored[:, 0] + 1j * stored[:, 1], psi)
+    n = len(position)
+    ours = [set() for _ in range(n)]
+    for i, j in voronoi_neighbours(position, box, (True, True)):
+        ours[i].add(j)
+        ours[j].add(i)
+    system = (freud.box.Box(*box, is2D=True),
+              np.column_stack([position - 0.5 * np.asarray(box), np.zeros(n)]))
+    voronoi = freud.locality.Voronoi()
+    voronoi.compute(system)
+    theirs = [set() for _ in range(n)]
+    for i, j in voronoi.nlist[:]:
+        theirs[i].add(j)
+    same = np.array([a == b for a, b in zip(ours, theirs, strict=True)])
+    assert same.mean() >= 0.99
+    oracle = _freud_order(position, box)
+    assert np.max(np.abs(psi - oracle)[same]) < 1e-5
+    diameter = 2.0 * float(data["radius"][0])
+    r, g6 = orientational_correlation(position, psi, box, (True, True), 24, 6 * diameter)
+    correlation = freud.density.CorrelationFunction(bins=24, r_max=6 * diameter)
+    correlation.compute(system, values=psi, neighbors={"r_max": 6 * diameter,
+                                                       "exclude_ii": True})
+    filled = np.isfinite(g6)
+    assert filled.sum() >= 20 and np.allclose(g6[filled], correlation.correlation[filled],
+                                               atol=1e-5)
