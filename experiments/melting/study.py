@@ -211,7 +211,7 @@ def _pending(todo):
     return rounds
 
 
-def _execute(rounds, jobs, cluster, out):
+def _execute(rounds, jobs, cluster, out, partition=None):
     if cluster is None:
         from joblib import Parallel, delayed
         # no run queued beyond those running: a study whose parent is gone starts no more
@@ -219,12 +219,13 @@ def _execute(rounds, jobs, cluster, out):
                                                             for p, c in rounds)
     import submitit
     executor = submitit.AutoExecutor(folder=Path(out) / "submitit", cluster=cluster)
-    executor.update_parameters(timeout_min=24 * 60, cpus_per_task=1)
+    executor.update_parameters(timeout_min=24 * 60, cpus_per_task=1,
+                               **({"slurm_partition": partition} if partition else {}))
     jobs = executor.map_array(advance, *zip(*rounds, strict=True))
     return [job.result() for job in jobs]
 
 
-def simulate(plan, out, jobs, cluster=None):
+def simulate(plan, out, jobs, cluster=None, partition=None):
     """Rounds of :func:`advance` until every point of ``plan`` is done; the longest points
     first in every round."""
     todo = points(plan, out)
@@ -232,7 +233,7 @@ def simulate(plan, out, jobs, cluster=None):
         rounds.sort(key=lambda pc: -pc[0].group.n * pc[1])
         print(f"melting: a round of {len(rounds)} runs, "
               f"{sum(p.group.n * c for p, c in rounds):.3g} collisions", flush=True)
-        _execute(rounds, jobs, cluster, out)
+        _execute(rounds, jobs, cluster, out, partition)
     return [_record(p) for p in todo]
 
 
@@ -469,6 +470,7 @@ def main(argv=None):
     parser.add_argument("--jobs", type=int, default=os.cpu_count())
     parser.add_argument("--cluster", choices=("slurm", "local"), default=None,
                         help="run the rounds through submitit instead of joblib")
+    parser.add_argument("--partition", default=None, help="the SLURM partition of the jobs")
     parser.add_argument("--quick", action="store_true", help="a smoke run: two short points")
     parser.add_argument("--report", action="store_true",
                         help="run nothing: the results of the points done so far")
@@ -482,7 +484,7 @@ def main(argv=None):
         plan = tuple(g for g in plan if g.name in args.groups)
     try:
         records = ([_record(p) for p in points(plan, args.out)] if args.report
-                   else simulate(plan, args.out, args.jobs, args.cluster))
+                   else simulate(plan, args.out, args.jobs, args.cluster, args.partition))
     except KeyboardInterrupt:
         print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
         return 130
