@@ -164,20 +164,31 @@ def advance(point, collisions_per_disk):
     started = time.process_time()
     path = point.folder / "run.h5"
     overrides = point.overrides(collisions_per_disk)
-    if path.exists():  # cut short, or to be run longer
-        stored, _ = stored_config(path)
-        collisions = max(stored.stop.collisions, collisions_per_disk * point.group.n)
-        resume(path, [f"stop.collisions={collisions}"])
-    else:
-        run(compose_config(overrides), point.folder, overrides=overrides)
-    return analyse(point, time.process_time() - started)
+    try:
+        if path.exists():  # cut short, or to be run longer
+            stored, _ = stored_config(path)
+            collisions = max(stored.stop.collisions, collisions_per_disk * point.group.n)
+            resume(path, [f"stop.collisions={collisions}"])
+        else:
+            run(compose_config(overrides), point.folder, overrides=overrides)
+    finally:  # a round cut short by a signal counts too
+        _spend(point, time.process_time() - started)
+    return analyse(point)
 
 
-def analyse(point, cpu_seconds=0.0):
+def _spend(point, seconds):
+    """Add ``seconds`` to the processor seconds the point has taken (its ``cpu_seconds``)."""
+    point.folder.mkdir(parents=True, exist_ok=True)
+    path = point.folder / "cpu_seconds"
+    before = (float(path.read_text()) if path.exists()
+              else (_record(point) or {}).get("cpu_seconds", 0.0))
+    path.write_text(repr(before + seconds))
+
+
+def analyse(point):
     """The point's record from its run file, written to its ``point.json``: βP d² and its
     analysis (:func:`run_pressure`), the mean |Ψ₆| of the production's snapshots, the
     processor seconds of every round so far."""
-    previous = _record(point) or {}
     with open_run(point.folder / "run.h5") as dataset:
         if dataset.attrs["stop_reason"] in ("interrupted", "terminated"):
             raise KeyboardInterrupt  # a signal: the study stops, a later one goes on
@@ -190,7 +201,7 @@ def analyse(point, cpu_seconds=0.0):
               "collisions_per_disk": collisions / g.n, "bPd2": eos.mean, "err": eos.error,
               "converged": bool(eos.converged), "cut": eos.cut, "blocks": eos.blocks,
               "drift": eos.drift, "psi6": float(np.mean(psi)),
-              "cpu_seconds": previous.get("cpu_seconds", 0.0) + cpu_seconds}
+              "cpu_seconds": float((point.folder / "cpu_seconds").read_text())}
     (point.folder / "point.json").write_text(json.dumps(record, indent=1))
     return record
 
