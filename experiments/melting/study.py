@@ -2,28 +2,33 @@
 at the sizes and in the boxes of the published references, run to the errors they ask for.
 
 Every state point of :data:`PLAN` is one run of the ``melting`` scene in a folder of its own
-under ``--out`` (``runs/<n>-<box>-<φ>-<start>/run.h5``), which also keeps the point's
-analysis (``point.json``). A point is run in rounds: the first runs ``first`` collisions per
-disk; after each, :func:`sim.analysis.equation_of_state.run_pressure` drops the equilibration
-blocks by the MSER rule and finds the blocking error of the rest, and the point is done when
-that error is at most the group's ``target``, the blocking has converged and the means of the
-production's two halves agree within 3 standard errors. Otherwise it is resumed to the length
-its error asks for (:func:`next_length`), at most ``longest`` collisions per disk; a point
-that reaches it is reported as missing its target. The rounds' runs go to joblib's worker
-processes (``--jobs``), or with ``--cluster slurm`` to SLURM through submitit, a job per run.
+under ``--out`` (``runs/<group>-<φ>/run.h5``), which also keeps the point's analysis
+(``point.json``) and the processor seconds it took (``cpu_seconds``). A point is run in
+rounds: the first runs ``first`` collisions per disk; after each,
+:func:`sim.analysis.equation_of_state.run_pressure` drops the equilibration blocks by the
+MSER rule and finds the blocking error of the rest, and the point is done when that error is
+at most the group's ``target``, the blocking has converged, the means of the production's two
+halves agree within :data:`DRIFT` standard errors and :data:`PRODUCTION_BLOCKS` blocks are
+kept. Otherwise it is resumed to the length its error asks for (:func:`next_length`), at most
+``longest`` collisions per disk; a point that reaches it stays as it is, its error in the
+tables. The rounds' runs go to joblib's worker processes (``--jobs``), or with ``--cluster
+slurm`` to SLURM through submitit, a job per run.
 
 Interrupted (Ctrl-C, a killed job, the end of a session), the study starts again where it
 was: a run resumes from its last checkpoint (written every 30 s of wall time and at every
 stop), a finished point is not run again, and a second ``make melting`` with every point done
-only reads the analyses and draws. The processor time of every round is added up per point.
+only reads the analyses and draws.
 
-Writes into ``--results`` (``make melting``: docs/results/): ``melting.csv`` (one row per run:
-n, aspect, phi, start, collisions_per_disk, bPd2, err, psi6), ``melting_reference.csv`` (the
-published value of each row's N, box and φ with its source), ``melting.json`` (per point the
-whole analysis and processor seconds; per group the published loop's extrema and ours),
-``melting_eos.png`` and ``melting_psi6.png``.
+Writes into ``--results`` (default outputs/melting/results; ``make melting`` copies them into
+docs/results/): ``melting.csv`` (one row per run: n, aspect, phi, start,
+collisions_per_disk, bPd2, err, psi6), ``melting_reference.csv`` (the published value of
+each row's N, box and φ with its source), ``melting.md`` (the runs against the published
+values, the loops' extrema, the processor hours), ``melting.json`` (per point the whole
+analysis and processor seconds; per group the published loop's extrema and ours),
+``melting_eos.png`` and ``melting_psi6.png`` (web versions; the full figures, PNG and PDF,
+in ``--out``/figures).
 
-    python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--quick]
+    python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--quick] [--report]
 """
 
 import argparse
@@ -43,7 +48,7 @@ from matplotlib.colors import Normalize
 from PIL import Image
 
 from sim.analysis.datasets import global_bond_order, open_run
-from sim.analysis.equation_of_state import run_pressure
+from sim.analysis.equation_of_state import block_pressures, run_pressure
 from sim.analysis.packing import orientational_correlation
 from sim.checks.melting import LARGE_N, loop_extrema, reference
 from sim.figures.style import draw_disks
@@ -67,7 +72,7 @@ PRODUCTION_BLOCKS = 64
 class Group:
     """State points of one N and box: ``phis`` (published packing fractions), started as
     ``start`` (``compressed``: a random gas compressed by growing disks; ``melted``: a
-    hexagonal lattice melted by ten collisions per disk); a snapshot, one block of the
+    hexagonal lattice melted by a short elastic run); a snapshot, one block of the
     pressure, every ``block`` collisions per disk; ``first`` collisions per disk in the first
     round, at most ``longest``; done at an error of βP d² of at most ``target``."""
 
@@ -193,11 +198,15 @@ def analyse(point):
         if dataset.attrs["stop_reason"] in ("interrupted", "terminated"):
             raise KeyboardInterrupt  # a signal: the study stops, a later one goes on
         eos = run_pressure(dataset)
-        psi = global_bond_order(dataset).values[1 + eos.cut:]
-        collisions = int(dataset["collisions"].values[-1])
+        _, ends = block_pressures(dataset)
+        snapshots = dataset["collisions"].values
+        production = snapshots > (ends[eos.cut - 1] if eos.cut else 0)
+        psi = global_bond_order(dataset).values[production]
+        collisions = int(snapshots[-1])
+        seed = int(dataset.attrs["seed"])
     g = point.group
     record = {"group": g.name, "n": g.n, "box": g.box, "aspect": point.aspect,
-              "phi": point.phi, "start": g.start, "seed": 0,
+              "phi": point.phi, "start": g.start, "seed": seed,
               "collisions_per_disk": collisions / g.n, "bPd2": eos.mean, "err": eos.error,
               "converged": bool(eos.converged), "cut": eos.cut, "blocks": eos.blocks,
               "drift": eos.drift, "psi6": float(np.mean(psi)),
@@ -340,7 +349,8 @@ def draw_equation_of_state(records, out, results):
         ax.set_xlabel("packing fraction φ")
         ax.set_ylabel("βP d²")
         ax.legend(fontsize=7)
-    fig.suptitle("Hard disks through melting: sim (seed 0, ±1 blocking standard error) "
+    seeds = ", ".join(str(seed) for seed in sorted({r["seed"] for r in records}))
+    fig.suptitle(f"Hard disks through melting: sim (seed {seeds}, ±1 blocking standard error) "
                  "against the published pressures (band: ±3 standard errors)", fontsize=10)
     publish(fig, "melting_eos", out, results)
 
@@ -364,6 +374,7 @@ def draw_bond_order(points_done, out, results):
             position, psi = last["position"].values, last["bond_order"].values
             radius = run_data["radius"].values
             box = tuple(run_data.attrs["box"])
+            seed = run_data.attrs["seed"]
         psi = psi[:, 0] + 1j * psi[:, 1]
         diameter = 2.0 * radius[0]
         r, g6 = orientational_correlation(position, psi, box, (True, True), 120, 12 * diameter)
@@ -379,7 +390,7 @@ def draw_bond_order(points_done, out, results):
                                "brightness |ψ₆|")
             left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[])
             left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start, last "
-                           f"snapshot (seed 0)", fontsize=10)
+                           f"snapshot (seed {seed})", fontsize=10)
     x = np.array([1.0, 12.0])
     right.loglog(x, x ** -0.25, color="k", lw=0.8, ls="--",
                  label="r^(−1/4), the slowest decay of a hexatic (KTHNY)")
