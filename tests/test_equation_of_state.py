@@ -102,3 +102,13 @@ def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
     drifting = run(compose_config([*overrides, "disks.zero_momentum=false"]), tmp_path / "b")
     with open_run(drifting) as data, pytest.raises(ValueError, match="total momentum"):
         block_pressures(data)
+
+
+def test_blocking_of_a_series_too_short_to_converge_gives_its_largest_error():
+    """A random walk of 64 steps has no plateau: not converged, and the error is the
+    largest level's (finite); fewer than MIN_BLOCKS entries give the naive error."""
+    walk = np.cumsum(np.random.default_rng(8).normal(size=64))
+    mean, error, converged, errors = blocking(walk)
+    assert not converged and np.isfinite(error) and error == errors.max()
+    short = walk[:5]
+    assert blocking(short)[1] == pytest.approx(short.std(ddof=1) / math.sqrt(5))

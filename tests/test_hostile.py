@@ -424,6 +424,18 @@ def test_a_misspelt_key_is_quoted_with_the_value_given(entry, tmp_path):
     assert "None" not in lines_of(result.err)[0], result.err
 
 
+def test_a_wrong_type_in_a_scenario_file_of_ones_own_is_named_by_its_key(entry, tmp_path):
+    """A scenario file on Hydra's search path with ``stop.collisions: 1.5e3``: one line
+    naming the key and the value, not "no such scenario"."""
+    scenes = tmp_path / "mine" / "scenario"
+    scenes.mkdir(parents=True)
+    (scenes / "bad.yaml").write_text("# @package _global_\nscene: gas\nstop:\n"
+                                     "  collisions: 1.5e3\n")
+    result = entry(f"hydra.searchpath=[file://{tmp_path / 'mine'}]", "scenario=bad")
+    check(result, 2, ["stop.collisions", "1500"])
+    assert "no such scenario" not in result.err
+
+
 # ---------------------------------------------------------------------------------------
 # numbers that look wrong but are fine: they run
 

@@ -92,3 +92,32 @@ def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_t
                        "--results", str(tmp_path / "whole" / "results")]) == 0
     assert "a round" not in capsys.readouterr().out
     assert [f.stat().st_mtime_ns for f in files] == stamps
+
+
+def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_should():
+    """next_length: none for a point that meets its target, has reached its longest run or
+    failed; else its error's ask (with the margin), within the growth's bounds, whole
+    blocks."""
+    study = _study()
+    group = study.Group("g", 72, "1:1", (0.65,), "compressed", 100, 10_000, 100_000, 0.01)
+    point = study.Point(group, 0.65, Path("unused"))
+    record = {"collisions_per_disk": 10_000, "err": 0.01, "converged": True, "drift": 0.5,
+              "blocks": 100, "cut": 0}
+    assert study.status(point, record) == "done" and study.next_length(point, record) is None
+    slightly = dict(record, err=0.0105)  # asks 1.3 × 1.1025: the growth's least, 1.5
+    assert study.next_length(point, slightly) == 15_000
+    far = dict(record, err=0.05)  # asks 32 times: the growth's most, 4
+    assert study.next_length(point, far) == 40_000
+    unknown = dict(record, err=float("nan"), converged=False)
+    assert study.next_length(point, unknown) == 40_000
+    drifting = dict(record, drift=4.0)
+    assert study.status(point, drifting) == "running"
+    few = dict(record, blocks=40, cut=60, err=0.001)  # asks 6000 cut + 64 blocks of 100
+    assert study.status(point, few) == "running" and study.next_length(point, few) == 15_000
+    fewer = dict(few, collisions_per_disk=2_000)  # 1200 cut + 6400: more than 1.5 times
+    assert study.next_length(point, fewer) == 7_600
+    longest = dict(far, collisions_per_disk=100_000)
+    assert study.status(point, longest) == "longest"
+    assert study.next_length(point, longest) is None
+    failed = {"collisions_per_disk": 5_000, "failed": "a run to its collisions"}
+    assert study.status(point, failed) == "failed" and study.next_length(point, failed) is None

@@ -1,5 +1,6 @@
 """The melting of hard disks: the equation of state βP d² through liquid–hexatic coexistence
-at the sizes and in the boxes of the published references, run to the errors they ask for.
+at the sizes and in the boxes of the published references, each point run until its error
+reaches its group's target.
 
 Every state point of :data:`PLAN` is one run of the ``melting`` scene in a folder of its own
 under ``--out`` (``runs/<group>-<φ>/run.h5``), which also keeps the point's analysis
@@ -48,7 +49,7 @@ from matplotlib.colors import Normalize
 from PIL import Image
 
 from sim.analysis.datasets import global_bond_order, open_run
-from sim.analysis.equation_of_state import block_pressures, run_pressure
+from sim.analysis.equation_of_state import run_pressure
 from sim.analysis.packing import orientational_correlation
 from sim.checks.melting import LARGE_N, loop_extrema, reference
 from sim.figures.style import draw_disks
@@ -66,6 +67,9 @@ MARGIN = 1.3
 GROWTH = (1.5, 4.0)
 #: the fewest production blocks of a point done: blocking has three levels of 8 and more
 PRODUCTION_BLOCKS = 64
+#: the version of :func:`analyse`'s rules a record was made with; a record of another is
+#: made anew from its run file when the study starts
+ANALYSIS = 2
 
 
 @dataclass(frozen=True)
@@ -147,14 +151,37 @@ def _record(point):
     return json.loads(path.read_text()) if path.exists() else None
 
 
-def next_length(point, record):
-    """Collisions per disk the point runs to in its next round, or None when it is done:
-    its error at most the target, its blocking converged, no drift and at least
-    :data:`PRODUCTION_BLOCKS` blocks kept; or its longest run reached."""
-    g = point.group
-    done = (record["err"] <= g.target and record["converged"]
+def _write(path, text):
+    """``text`` into ``path`` whole or not at all (a signal between the two leaves the old)."""
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(text)
+    os.replace(partial, path)
+
+
+def reached(point, record):
+    """Whether the point's run meets its group's target: error, convergence, no drift and
+    :data:`PRODUCTION_BLOCKS` blocks kept."""
+    return (record["err"] <= point.group.target and record["converged"]
             and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS)
-    if done or record["collisions_per_disk"] >= g.longest:
+
+
+def status(point, record):
+    """``done``, ``longest`` (run to its group's longest, its target missed), ``failed``
+    (the reason in its record) or ``running``."""
+    if "failed" in record:
+        return "failed"
+    if reached(point, record):
+        return "done"
+    return "longest" if record["collisions_per_disk"] >= point.group.longest else "running"
+
+
+def next_length(point, record):
+    """Collisions per disk the point runs to in its next round, or None when it has none
+    (:func:`status` other than ``running``): the length its error asks for, to
+    :data:`MARGIN`, from :data:`GROWTH` [0] to [1] times its length so far, at most its
+    group's longest, a whole number of blocks."""
+    g = point.group
+    if status(point, record) != "running":
         return None
     length = record["collisions_per_disk"]
     production = length * record["blocks"] / (record["blocks"] + record["cut"])
@@ -178,7 +205,10 @@ def advance(point, collisions_per_disk):
             run(compose_config(overrides), point.folder, overrides=overrides)
     finally:  # a round cut short by a signal counts too
         _spend(point, time.process_time() - started)
-    return analyse(point)
+    record = analyse(point)
+    if record is None:  # the run stopped at a signal: so does the study
+        raise KeyboardInterrupt
+    return record
 
 
 def _spend(point, seconds):
@@ -187,31 +217,39 @@ def _spend(point, seconds):
     path = point.folder / "cpu_seconds"
     before = (float(path.read_text()) if path.exists()
               else (_record(point) or {}).get("cpu_seconds", 0.0))
-    path.write_text(repr(before + seconds))
+    _write(path, repr(before + seconds))
 
 
 def analyse(point):
     """The point's record from its run file, written to its ``point.json``: βP d² and its
     analysis (:func:`run_pressure`), the mean |Ψ₆| of the production's snapshots, the
-    processor seconds of every round so far."""
-    with open_run(point.folder / "run.h5") as dataset:
-        if dataset.attrs["stop_reason"] in ("interrupted", "terminated"):
-            raise KeyboardInterrupt  # a signal: the study stops, a later one goes on
-        eos = run_pressure(dataset)
-        _, ends = block_pressures(dataset)
-        snapshots = dataset["collisions"].values
-        production = snapshots > (ends[eos.cut - 1] if eos.cut else 0)
-        psi = global_bond_order(dataset).values[production]
-        collisions = int(snapshots[-1])
-        seed = int(dataset.attrs["seed"])
+    processor seconds of every round so far; or its reason to have none (``failed``). None
+    for a run cut short by a signal."""
     g = point.group
+    spent = point.folder / "cpu_seconds"
     record = {"group": g.name, "n": g.n, "box": g.box, "aspect": point.aspect,
-              "phi": point.phi, "start": g.start, "seed": seed,
-              "collisions_per_disk": collisions / g.n, "bPd2": eos.mean, "err": eos.error,
-              "converged": bool(eos.converged), "cut": eos.cut, "blocks": eos.blocks,
-              "drift": eos.drift, "psi6": float(np.mean(psi)),
-              "cpu_seconds": float((point.folder / "cpu_seconds").read_text())}
-    (point.folder / "point.json").write_text(json.dumps(record, indent=1))
+              "phi": point.phi, "start": g.start, "analysis": ANALYSIS,
+              "cpu_seconds": (float(spent.read_text()) if spent.exists()
+                              else (_record(point) or {}).get("cpu_seconds", 0.0))}
+    with open_run(point.folder / "run.h5") as dataset:
+        reason = dataset.attrs["stop_reason"]
+        if reason in ("interrupted", "terminated"):
+            return None  # cut short by a signal: a later round goes on
+        record["seed"] = int(dataset.attrs["seed"])
+        snapshots = dataset["collisions"].values
+        record["collisions_per_disk"] = int(snapshots[-1]) / g.n
+        try:
+            if reason != "collisions":
+                raise ValueError(f"a run to its collisions, not one stopped by {reason}")
+            eos = run_pressure(dataset)
+        except ValueError as error:  # reported, never run again
+            record["failed"] = str(error)
+        else:
+            psi = global_bond_order(dataset).values[snapshots > eos.production_start]
+            record |= {"bPd2": eos.mean, "err": eos.error, "converged": bool(eos.converged),
+                       "cut": eos.cut, "blocks": eos.blocks, "drift": eos.drift,
+                       "psi6": float(np.mean(psi))}
+    _write(point.folder / "point.json", json.dumps(record, indent=1))
     return record
 
 
@@ -220,6 +258,8 @@ def _pending(todo):
     rounds = []
     for point in todo:
         record = _record(point)
+        if record is not None and record.get("analysis") != ANALYSIS:
+            record = analyse(point)  # analysed by an older rule: read its run again
         if record is None:
             if (point.folder / "run.h5").exists():  # cut short before its first analysis
                 stored = stored_config(point.folder / "run.h5")[0]
@@ -241,20 +281,19 @@ def _execute(rounds, jobs, cluster, out, partition=None):
     executor = submitit.AutoExecutor(folder=Path(out) / "submitit", cluster=cluster)
     executor.update_parameters(timeout_min=24 * 60, cpus_per_task=1,
                                **({"slurm_partition": partition} if partition else {}))
-    jobs = executor.map_array(advance, *zip(*rounds, strict=True))
-    return [job.result() for job in jobs]
+    submitted = executor.map_array(advance, *zip(*rounds, strict=True))
+    return [job.result() for job in submitted]
 
 
 def simulate(plan, out, jobs, cluster=None, partition=None):
-    """Rounds of :func:`advance` until every point of ``plan`` is done; the longest points
-    first in every round."""
+    """Rounds of :func:`advance` until no point of ``plan`` has one to run; the longest
+    points first in every round."""
     todo = points(plan, out)
     while rounds := _pending(todo):
         rounds.sort(key=lambda pc: -pc[0].group.n * pc[1])
         print(f"melting: a round of {len(rounds)} runs, "
               f"{sum(p.group.n * c for p, c in rounds):.3g} collisions", flush=True)
         _execute(rounds, jobs, cluster, out, partition)
-    return [_record(p) for p in todo]
 
 
 # ---------------------------------------------------------------------------- the results
@@ -285,16 +324,23 @@ SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157,
 
 
 def extrema(records):
-    """Per group with a loop in its published curve: the published maximum and minimum
-    and ours (:func:`loop_extrema`), where our points show one."""
+    """Per group with a loop in its published curve: the published maximum and minimum from
+    all its points and from those at our φ only, and ours (:func:`loop_extrema`), where our
+    points show one. The vertex of a parabola depends on the points fitted: ours compare
+    with the published ones at our φ."""
     found = {}
     for name in dict.fromkeys(r["group"] for r in records):
         mine = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
-        published = loop_extrema(*reference(mine[0]["n"], mine[0]["box"])[:3])
+        phi, pressure, error, _ = reference(mine[0]["n"], mine[0]["box"])
+        published = loop_extrema(phi, pressure, error)
         if published is None:
             continue
-        ours = loop_extrema(*(np.array([r[k] for r in mine]) for k in ("phi", "bPd2", "err")))
-        found[name] = {"published": published, "sim": ours}
+        ours = np.array([[r[k] for k in ("phi", "bPd2", "err")] for r in mine]).T
+        same = np.isin(np.round(phi, 3), np.round(ours[0], 3))
+        found[name] = {"published": published,
+                       "published_at_our_phi": loop_extrema(*(x[same] for x in
+                                                              (phi, pressure, error))),
+                       "sim": loop_extrema(*ours)}
     return found
 
 
@@ -332,12 +378,17 @@ def draw_equation_of_state(records, out, results):
                 ax.plot(lphi, lp, color=f"C{k + 2}", lw=0.8, ls="--", label=label)
         mine = [r for r in records if r["n"] == n and r["box"] == box]
         for start, marker in (("compressed", "o"), ("melted", "s")):
-            rows = sorted((r for r in mine if r["start"] == start), key=lambda r: r["phi"])
-            if rows:
-                ax.errorbar([r["phi"] for r in rows], [r["bPd2"] for r in rows],
-                            [r["err"] for r in rows], fmt=marker, ms=3.5, capsize=2,
-                            mfc="none" if start == "melted" else None,
-                            label=f"sim, from a {start} start")
+            for done in (True, False):
+                rows = sorted((r for r in mine if r["start"] == start
+                               and (r["status"] == "done") == done), key=lambda r: r["phi"])
+                if rows:
+                    ax.errorbar([r["phi"] for r in rows], [r["bPd2"] for r in rows],
+                                [r["err"] for r in rows], fmt=marker, ms=3.5, capsize=2,
+                                mfc="none" if start == "melted" else None,
+                                color="C0" if start == "compressed" else "C1",
+                                alpha=1.0 if done else 0.35,
+                                label=f"sim, from a {start} start"
+                                      + ("" if done else ", not done yet"))
         if mine:
             lo, hi = min(r["phi"] for r in mine), max(r["phi"] for r in mine)
             inside = (phi >= lo - 0.003) & (phi <= hi + 0.003)
@@ -402,20 +453,26 @@ def draw_bond_order(points_done, out, results):
 
 
 def _cost(records):
-    """Processor hours per group, and what N = 256² at the points of N = 128² would cost at
-    least: four times the disks, the same collisions per disk at the rate of N = 128²."""
+    """Processor hours per group, and what a point of N = 256² at the points of N = 128²
+    would cost at least: four times the disks, the same collisions per disk at the rate of
+    N = 128² (its points done)."""
     hours = {}
     for r in records:
         hours[r["group"]] = hours.get(r["group"], 0.0) + r["cpu_seconds"] / 3600.0
-    large = [r for r in records if r["n"] == 16384 and r["cpu_seconds"] > 0]
-    per_point = (4.0 * sum(r["cpu_seconds"] for r in large) / len(large) / 3600.0
-                 if large else None)
-    return hours, per_point
+    large = [r for r in records if r["n"] == 16384 and r.get("status") == "done"]
+    large_point_hours = (4.0 * sum(r["cpu_seconds"] for r in large) / len(large) / 3600.0
+                         if large else None)
+    return hours, large_point_hours
+
+
+def _extreme(e):
+    return "none in the points" if e is None else \
+        f"{e[0]:.4f} ± {e[1]:.4f}, {e[2]:.4f} ± {e[3]:.4f}"
 
 
 def write_markdown(records, found, results):
-    """melting.md: every run against the published value of its N and box, the loops'
-    extrema, the processor hours."""
+    """melting.md: every run against the published value of its N and box, with its state,
+    the loops' extrema, the processor hours."""
     lines = [f"A point is done when the blocking error of βP d² over its production is at "
              f"most its group's target, the blocking has converged, the means of the "
              f"production's halves differ by less than {DRIFT:g} standard errors and at "
@@ -424,13 +481,14 @@ def write_markdown(records, found, results):
              f"length so far). Targets: "
              + "; ".join(f"{g.name} {g.target:g} (a block every {g.block} collisions per "
                          f"disk, at most {g.longest:.3g})" for g in PLAN) + ".", ""]
-    for name in dict.fromkeys(r["group"] for r in records):
-        rows = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
+    measured = [r for r in records if "bPd2" in r]
+    for name in dict.fromkeys(r["group"] for r in measured):
+        rows = sorted((r for r in measured if r["group"] == name), key=lambda r: r["phi"])
         phi, pressure, error, _ = reference(rows[0]["n"], rows[0]["box"])
         lines += [f"**N = {rows[0]['n']}, box {rows[0]['box']}, {rows[0]['start']} start**",
                   "", "| φ | βP d², sim | published | difference / combined error | "
-                  "collisions per disk | equilibration cut | drift | ⟨|Ψ₆|⟩ |",
-                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+                  "collisions per disk | equilibration cut | drift | ⟨|Ψ₆|⟩ | state |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
         for r in rows:
             k = int(np.argmin(np.abs(phi - r["phi"])))
             z = (r["bPd2"] - pressure[k]) / math.hypot(r["err"], error[k])
@@ -438,48 +496,55 @@ def write_markdown(records, found, results):
                          f"{pressure[k]:.4f} ± {error[k]:.4f} | {z:+.1f} | "
                          f"{r['collisions_per_disk']:.3g} | {r['cut']} of "
                          f"{r['cut'] + r['blocks']} blocks | {r['drift']:+.1f} | "
-                         f"{r['psi6']:.3f} |")
+                         f"{r['psi6']:.3f} | {r['status']} |")
         lines.append("")
+    for r in records:
+        if "failed" in r:
+            lines += [f"Failed: N = {r['n']}, box {r['box']}, φ = {r['phi']:.3f}: "
+                      f"{r['failed']}.", ""]
     if found:
         lines += ["**The loops' extrema** (a parabola through the five points about each; "
-                  "errors from resampling the points within theirs)", "",
-                  "| N, box | maximum: published φ, βP d² | sim | minimum: published φ, "
-                  "βP d² | sim |", "| --- | --- | --- | --- | --- |"]
-
-        def extreme(e):
-            return "none in the points" if e is None else \
-                f"{e[0]:.4f} ± {e[1]:.4f}, {e[2]:.4f} ± {e[3]:.4f}"
-        for name, both in found.items():
-            sim = both["sim"] or {"max": None, "min": None}
-            lines.append(f"| {name} | {extreme(both['published']['max'])} | "
-                         f"{extreme(sim['max'])} | {extreme(both['published']['min'])} | "
-                         f"{extreme(sim['min'])} |")
+                  "errors: half the 16–84 % range over resamplings of the points within "
+                  "their errors). The published ones from all their points, and from those "
+                  "at the φ of the runs, which compare with ours.", "",
+                  "| N, box | | maximum: φ, βP d² | minimum: φ, βP d² |",
+                  "| --- | --- | --- | --- |"]
+        for name, all_three in found.items():
+            for label, key in (("published, all points", "published"),
+                               ("published, at our φ", "published_at_our_phi"),
+                               ("sim", "sim")):
+                e = all_three[key] or {"max": None, "min": None}
+                lines.append(f"| {name} | {label} | {_extreme(e['max'])} | "
+                             f"{_extreme(e['min'])} |")
         lines.append("")
-    hours, per_point = _cost(records)
+    hours, large_point_hours = _cost(records)
     lines.append("Processor hours: " + "; ".join(f"{k} {v:.2f}" for k, v in hours.items())
                  + f"; in all {sum(hours.values()):.2f}.")
-    if per_point is not None:
-        lines.append(f"N = 256² would take at least {per_point:.2f} processor hours per state "
-                     f"point (four times the disks of N = 128² at the same collisions per "
-                     f"disk; its slower relaxation would ask for more).")
-    (results / "melting.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    if large_point_hours is not None:
+        lines.append(f"N = 256² would take at least {large_point_hours:.2f} processor hours "
+                     f"per state point (four times the disks of N = 128² at the same "
+                     f"collisions per disk; its slower relaxation would ask for more).")
+    _write(results / "melting.md", "\n".join(lines) + "\n")
 
 
-def summarise(records, out, results, todo):
-    """The tables, the figures, melting.md and melting.json of the points done."""
-    records = [r for r in records if r is not None]
+def summarise(todo, out, results):
+    """The tables, the figures, melting.md and melting.json of the points of ``todo`` that
+    have a record, each with its :func:`status`."""
+    records = [dict(record, status=status(p, record)) for p in todo
+               if (record := _record(p)) is not None]
+    measured = [r for r in records if "bPd2" in r]
     results.mkdir(parents=True, exist_ok=True)
-    write_tables(records, results)
-    found = extrema(records)
+    write_tables(measured, results)
+    found = extrema(measured)
     write_markdown(records, found, results)
-    draw_equation_of_state(records, out, results)
-    draw_bond_order([p for p in todo if _record(p) is not None], out, results)
+    draw_equation_of_state(measured, out, results)
+    draw_bond_order([p for p in todo if "bPd2" in (_record(p) or {})], out, results)
     hours, _ = _cost(records)
     summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
                "rules": {"drift": DRIFT, "margin": MARGIN, "growth": GROWTH,
                          "production_blocks": PRODUCTION_BLOCKS}}
-    (results / "melting.json").write_text(json.dumps(summary, indent=1, default=float))
+    _write(results / "melting.json", json.dumps(summary, indent=1, default=float))
     print(f"melting: {len(records)} points, {sum(hours.values()):.2f} processor hours, "
           f"into {results}")
 
@@ -505,12 +570,12 @@ def main(argv=None):
                          + ", ".join(g.name for g in plan))
         plan = tuple(g for g in plan if g.name in args.groups)
     try:
-        records = ([_record(p) for p in points(plan, args.out)] if args.report
-                   else simulate(plan, args.out, args.jobs, args.cluster, args.partition))
+        if not args.report:
+            simulate(plan, args.out, args.jobs, args.cluster, args.partition)
     except KeyboardInterrupt:
         print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
         return 130
-    summarise(records, args.out, args.results, points(plan, args.out))
+    summarise(points(plan, args.out), args.out, args.results)
     return 0
 
 

@@ -17,15 +17,15 @@ near melting, 1.2 % and 0.15 %, far beyond the published errors of small-N press
 Errors. Successive blocks of a run are correlated; the blocking transformation of Flyvbjerg
 & Petersen (J. Chem. Phys. 91, 461 (1989)) averages neighbours pairwise, level after level,
 and the naive standard error of the blocked series grows until the blocks are independent,
-then stays on a plateau within its own error. :func:`blocking` returns every level and the
-first level whose error agrees with the next within the error of its error (or the last
-with at least :data:`MIN_BLOCKS` blocks, flagged as not converged).
+then stays on a plateau. :func:`blocking` finds the first level of the plateau by Jonsson's
+test of the remaining levels' lag-one correlations (or flags the series as too short).
 """
 
 import math
 from collections import namedtuple
 
 import numpy as np
+from scipy.stats import chi2
 
 #: the fewest blocks a level of :func:`blocking` may keep
 MIN_BLOCKS = 8
@@ -46,29 +46,39 @@ def reduced_pressure_d2(n, kinetic, virial, elapsed, area, diameter):
 
 
 def blocking(series):
-    """Flyvbjerg–Petersen blocking of a correlated ``series`` float64[m]: (mean, standard
-    error, converged, errors per level float64[levels]). The error is that of the first
-    level beyond which no level's error exceeds it by more than twice that level's own
-    error (a standard error from b blocks is uncertain by about 1/√(2(b − 1)) of itself),
-    else the largest of all levels of at least :data:`MIN_BLOCKS` blocks, with ``converged``
-    False; a series shorter than :data:`MIN_BLOCKS` (at least two entries) has only its naive
-    error, not converged."""
+    """The standard error of the mean of a correlated ``series`` float64[m] by blocking, the
+    level chosen by Jonsson's test (Phys. Rev. E 98, 043304 (2018)): (mean, standard error,
+    converged, errors per level float64[levels]).
+
+    Level k averages neighbours pairwise k times (Flyvbjerg & Petersen, J. Chem. Phys. 91,
+    461 (1989)), n_k blocks of variance s_k² (about the series' mean) and lag-one
+    autocovariance γ_k. While the blocks are correlated, M_k = Σ_{j ≥ k} n_j (γ_j / s_j²)²
+    exceeds the 99 % quantile of χ² with as many degrees of freedom as levels from k on; the
+    error is √(s_k²/n_k) of the first level below it. ``converged`` is False when no level
+    of :data:`MIN_BLOCKS` blocks or more passes but the last of them (the error is then the
+    largest of those levels'), and for a series shorter than :data:`MIN_BLOCKS` (at least
+    two entries; its naive error)."""
     x = np.asarray(series, np.float64)
     mean = float(x.mean())
-    errors, counts = [], []
-    while x.size >= MIN_BLOCKS:
-        errors.append(float(x.std(ddof=1) / math.sqrt(x.size)))
+    if x.size < MIN_BLOCKS:  # too few to block: the naive error, flagged
+        return mean, float(x.std(ddof=1) / math.sqrt(x.size)), False, np.array([])
+    variance, autocovariance, counts = [], [], []
+    while x.size >= 2:
+        deviation = x - mean
+        variance.append(float(np.mean(deviation * deviation)))
+        autocovariance.append(float(np.mean(deviation[:-1] * deviation[1:])))
         counts.append(x.size)
         x = 0.5 * (x[: x.size // 2 * 2: 2] + x[1: x.size // 2 * 2: 2])
-    if not errors:  # too few to block: the naive error, flagged
-        return mean, float(x.std(ddof=1) / math.sqrt(x.size)), False, np.array([])
-    errors, counts = np.array(errors), np.array(counts)
-    uncertain = errors / np.sqrt(2.0 * (counts - 1))
-    for level in range(len(errors) - 1):
-        later = slice(level + 1, None)
-        if np.all(errors[later] - errors[level] <= 2.0 * uncertain[later]):
-            return mean, float(errors[level]), True, errors
-    return mean, float(errors.max(initial=math.nan)), False, errors
+    variance, autocovariance, counts = (np.array(v) for v in (variance, autocovariance, counts))
+    errors = np.sqrt(variance / counts)
+    statistic = np.cumsum((counts * (autocovariance / variance) ** 2)[::-1])[::-1]
+    quantile = chi2.ppf(0.99, np.arange(counts.size, 0, -1))
+    usable = counts >= MIN_BLOCKS
+    passed = np.flatnonzero((statistic < quantile) & usable)
+    if passed.size:  # a plateau seen on one level only (the last usable) is not trusted
+        return (mean, float(errors[passed[0]]), bool(passed[0] < usable.sum() - 1),
+                errors[usable])
+    return mean, float(errors[usable].max()), False, errors[usable]
 
 
 def equilibration_cut(series):
@@ -80,7 +90,7 @@ def equilibration_cut(series):
     x = np.asarray(series, np.float64)
     m = x.size
     kept = m - np.arange(m // 2 + 1)
-    tail = x[::-1]
+    tail = x[::-1] - x.mean()  # the sums about the mean: no cancellation
     mean = np.cumsum(tail)[kept - 1] / kept  # x̄_d over x[d:]
     squares = np.cumsum(tail * tail)[kept - 1]
     return int(np.argmin((squares - kept * mean * mean) / kept**2))
@@ -105,8 +115,8 @@ def block_pressures(run):
         raise ValueError("a constant kinetic energy (an elastic run)")
     collisions = run["collisions"].values
     steps = np.diff(collisions)
-    cadence = np.bincount(steps).argmax() if steps.size else 0
-    whole = steps == cadence
+    lengths, counts = np.unique(steps, return_counts=True)
+    whole = steps == (lengths[np.argmax(counts)] if steps.size else 0)
     area = float(np.prod(run.attrs["box"]))
     pressure = reduced_pressure_d2(radius.size, kinetic[0],
                                    np.diff(run["collision_virial"].values)[whole],
@@ -115,17 +125,19 @@ def block_pressures(run):
 
 
 EquationOfStatePoint = namedtuple(
-    "EquationOfStatePoint", "mean error converged cut blocks drift")
+    "EquationOfStatePoint", "mean error converged cut blocks drift production_start")
 EquationOfStatePoint.__doc__ = """βP d² of a run: the ``mean`` and blocking ``error`` over its
 production blocks (``converged`` as :func:`blocking` says), the ``cut`` equilibration blocks
-dropped (:func:`equilibration_cut`), the ``blocks`` kept, and the ``drift``: the difference of
+dropped (:func:`equilibration_cut`), the ``blocks`` kept, the ``drift``: the difference of
 the means of the production's second and first halves over its standard error (blocking
-errors of the halves), below 3 for a run whose averages no longer drift."""
+errors of the halves), a few at most for a run whose averages no longer drift; and the
+collisions at which the production starts (the snapshot that ends the last block cut, or
+the first)."""
 
 
 def run_pressure(run):
     """The :class:`EquationOfStatePoint` of the run Dataset ``run`` (:func:`block_pressures`)."""
-    pressure, _ = block_pressures(run)
+    pressure, ends = block_pressures(run)
     if pressure.size < 2 * MIN_BLOCKS:
         raise ValueError(f"at least {2 * MIN_BLOCKS} blocks of pressure, not {pressure.size}")
     cut = equilibration_cut(pressure)
@@ -134,4 +146,6 @@ def run_pressure(run):
     half = production.size // 2
     first, second = blocking(production[:half]), blocking(production[half:])
     drift = (second[0] - first[0]) / math.hypot(first[1], second[1])
-    return EquationOfStatePoint(mean, error, converged, cut, production.size, float(drift))
+    start = int(ends[cut - 1]) if cut else int(run["collisions"].values[0])
+    return EquationOfStatePoint(mean, error, converged, cut, production.size, float(drift),
+                                start)

@@ -95,9 +95,12 @@ def small_n_pressure(n=72, box="1:1", phis=(0.65,), seed=0, collisions=300_000):
 def loop_extrema(phi, pressure, error, draws=2000, seed=0):
     """The maximum and the minimum of a van der Waals loop through the points (``phi``,
     ``pressure`` ± ``error``, float64[m] in increasing φ): {"max": (φ, σ_φ, p, σ_p), "min":
-    (…)} from a parabola fitted (weighted by 1/error²) to the five points about each
-    extreme point, with errors as the spread over ``draws`` resamplings of the points within
-    their errors; None when the points do not rise, fall and rise again."""
+    (…)}, each the vertex of a parabola fitted (weighted by 1/error²) to the five points about
+    the extreme point, with errors as half the 16–84 % range of the vertices of ``draws``
+    resamplings of the points within their errors (a resampling whose parabola bends the
+    other way or whose vertex leaves the five points' span is left out); None when the
+    points do not rise, fall and rise again. The vertex depends on the points fitted: compare
+    two curves on the same φ."""
     phi, pressure, error = (np.asarray(x, np.float64) for x in (phi, pressure, error))
     inner = np.arange(1, phi.size - 1)
     peaks = inner[(pressure[inner] > pressure[inner - 1]) & (pressure[inner] > pressure[inner + 1])]
@@ -111,15 +114,20 @@ def loop_extrema(phi, pressure, error, draws=2000, seed=0):
     rng = np.random.default_rng(seed)
     samples = pressure + error * rng.standard_normal((draws, phi.size))
     extrema = {}
-    for name, k in (("max", top), ("min", int(dips[0]))):
+    for name, k, bend in (("max", top, -1.0), ("min", int(dips[0]), 1.0)):
         near = slice(max(k - 2, 0), min(k + 3, phi.size))
         x = phi[near] - phi[k]
         vertices = []
         for y in (pressure[near], *samples[:, near]):
             c2, c1, c0 = np.polyfit(x, y, 2, w=1.0 / error[near])
-            at = -c1 / (2.0 * c2) if c2 != 0 else 0.0
-            vertices.append((phi[k] + at, c0 + c1 * at + c2 * at * at))
-        vertices = np.array(vertices)
-        spread = vertices[1:].std(axis=0)
-        extrema[name] = (vertices[0, 0], spread[0], vertices[0, 1], spread[1])
+            at = -c1 / (2.0 * c2) if c2 * bend > 0 else np.nan
+            if x[0] <= at <= x[-1]:
+                vertices.append((phi[k] + at, c0 + c1 * at + c2 * at * at))
+            elif not vertices:  # the points' own parabola: none
+                break
+        if not vertices or len(vertices) < draws // 2:
+            return None
+        low, high = np.percentile(np.array(vertices[1:]), [16.0, 84.0], axis=0)
+        extrema[name] = (vertices[0][0], 0.5 * (high[0] - low[0]), vertices[0][1],
+                         0.5 * (high[1] - low[1]))
     return extrema

@@ -125,7 +125,8 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
     1.034 at 0.1, 1.032 at 0.7, 1.050 at N = 1e5.
 
     The same rule bounds the search: a pair's event is looked for only before
-    min(τ, t_j − t), τ the earliest event found so far and t_j j's next event, so that the
+    min(τ, t_j − t) (never below 0: t_j may lie before t by round-off), τ the earliest event
+    found so far and t_j j's next event, so that the
     filter of the pair's rule (:func:`sim.engine.kinematics.may_touch_before` for hard
     cores) spares the root of every contact that would be left out anyway. In a dense gas,
     where most neighbours are about to collide with a disk of their own, that is most of
@@ -172,7 +173,7 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
         vy_ij = vy - vy_j - uy
         sigma, sigma_rate = growing(effects.growth, r_i + table[j, RADIUS], now)
         tau_ij, event_ij = pair_event_time(pair, i, j, rx, ry, vx_ij, vy_ij, sigma, sigma_rate,
-                                           min(tau, event_time[j] - t),
+                                           max(min(tau, event_time[j] - t), 0.0),
                                            optional_entry(neighbours.pair_state, k, 0),
                                            disks)
         if tau_ij < tau and t + tau_ij <= event_time[j]:

@@ -16,8 +16,10 @@ it compiles the loop, so the registry is fixed at import. The rules are
     velocity v = v_i − v_j, hard-core distance σ = R_i + R_j, the pair's ``state``, the loop's
     disk group) as (time until it, event): ``event`` a whole number ≥ 0 that names the kind's
     own event (a core contact, a step crossed …), kept with the prediction and given to
-    ``apply``; a time ``math.inf`` for none. It may return any time ≥ τ, the earliest event
-    found so far, when the pair has none before τ; never a negative time.
+    ``apply``; a time ``math.inf`` for none. It may return any time ≥ τ when the pair has
+    none before τ ≥ 0, the time before which an event can matter (the earliest event of
+    disk i found so far, or the next event of j if that comes sooner; 0 when j's event is
+    now); never a negative time.
 ``apply`` (optional; default :func:`collide`, the hard-core contact)
     ``apply(value, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
     contact)`` with both disks flown to t, where ``contact`` is the run's count of contacts

@@ -6,7 +6,7 @@ and an exit status (:mod:`sim.pipeline.cli_exits`)."""
 import os
 from pathlib import Path
 
-from hydra.errors import MissingConfigException
+from hydra.errors import ConfigCompositionException, MissingConfigException
 from omegaconf import OmegaConf
 from omegaconf.errors import KeyValidationError, ValidationError
 
@@ -37,11 +37,14 @@ from sim.storage.errors import RunFileError
 
 def _type_error(error):
     """A value of the wrong type, as a :class:`ConfigError` naming the key (or None)."""
-    while not isinstance(error, ValidationError) and (error.__cause__ or error.__context__):
-        error = error.__cause__ or error.__context__  # Hydra raises inside its except
+    while not isinstance(error, ValidationError):
+        # Hydra raises its composition error inside the except of the one it reports
+        error = error.__cause__ or (error.__context__
+                                    if isinstance(error, ConfigCompositionException) else None)
+        if error is None:
+            return None
     key = getattr(error, "full_key", None)
-    if not isinstance(error, ValidationError) or isinstance(error, KeyValidationError) \
-            or not key:
+    if isinstance(error, KeyValidationError) or not key:
         return None
     message = getattr(error, "msg", "") or ""
     kinds = {"Integer": "a whole number", "Float": "a number", "Boolean": "true or false",
