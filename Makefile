@@ -57,6 +57,7 @@ melting: $(STAMP)  ## the equation of state through melting at the published siz
 	$(if $(QUICK),,cp outputs/melting/results/melting.json $(RESULTS)/melting.json)
 	$(if $(QUICK),,cp outputs/melting/results/melting_eos.png $(RESULTS)/melting_eos.png)
 	$(if $(QUICK),,cp outputs/melting/results/melting_psi6.png $(RESULTS)/melting_psi6.png)
+	$(if $(QUICK),,cp outputs/melting/results/melting_starts.png $(RESULTS)/melting_starts.png)
 
 dsmc: $(STAMP)  ## the cooling states of rough disks by DSMC, the validation table's references, into docs/results/
 	$(PY) -m sim.checks.dsmc --out $(RESULTS)/dsmc.json

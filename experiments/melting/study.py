@@ -26,8 +26,8 @@ collisions_per_disk, bPd2, err, psi6), ``melting_reference.csv`` (the published 
 each row's N, box and φ with its source), ``melting.md`` (the runs against the published
 values, the loops' extrema, the processor hours), ``melting.json`` (per point the whole
 analysis and processor seconds; per group the published loop's extrema and ours),
-``melting_eos.png`` and ``melting_psi6.png`` (web versions; the full figures, PNG and PDF,
-in ``--out``/figures).
+``melting_eos.png``, ``melting_psi6.png`` and ``melting_starts.png`` (web versions; the full
+figures, PNG and PDF, in ``--out``/figures).
 
     python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--quick] [--report]
 """
@@ -49,7 +49,7 @@ from matplotlib.colors import Normalize
 from PIL import Image
 
 from sim.analysis.datasets import global_bond_order, open_run
-from sim.analysis.equation_of_state import run_pressure
+from sim.analysis.equation_of_state import block_pressures, run_pressure
 from sim.analysis.packing import orientational_correlation
 from sim.checks.melting import LARGE_N, loop_extrema, reference
 from sim.figures.style import draw_disks
@@ -406,6 +406,44 @@ def draw_equation_of_state(records, out, results):
     publish(fig, "melting_eos", out, results)
 
 
+def draw_starts(todo, out, results):
+    """The runs of N = 128² started both ways at the same φ, as far as they have come: βP d²
+    of every block and |Ψ₆| of every snapshot against collisions per disk, the published
+    βP d² beside; so that the two starts are seen to meet."""
+    large = [p for p in todo if p.group.n == 16384]
+    twice = sorted({p.phi for p in large if p.group.start == "melted"}
+                   & {p.phi for p in large if p.group.start == "compressed"})
+    if not twice:
+        return
+    fig, axes = plt.subplots(2, len(twice), figsize=(5.5 * len(twice), 6.0), squeeze=False,
+                             constrained_layout=True, sharex="col")
+    for column, phi in enumerate(twice):
+        top, bottom = axes[0, column], axes[1, column]
+        published = reference(16384, "1:1")
+        k = int(np.argmin(np.abs(published[0] - phi)))
+        top.axhspan(published[1][k] - 3 * published[2][k], published[1][k] + 3 * published[2][k],
+                    color="0.6", alpha=0.4, label="Li et al. 2022 (±3 standard errors)")
+        for point in (p for p in large if p.phi == phi):
+            try:
+                run_data = open_run(point.folder / "run.h5")
+            except RunFileError:  # running now, or not begun
+                continue
+            with run_data:
+                pressure, ends = block_pressures(run_data)
+                order = global_bond_order(run_data)
+                per_disk = run_data["collisions"].values / point.group.n
+            colour = "C0" if point.group.start == "compressed" else "C1"
+            top.plot(ends / point.group.n, pressure, lw=0.6, color=colour,
+                     label=f"{point.group.start} start, each block")
+            bottom.plot(per_disk, order.values, lw=0.8, color=colour,
+                        label=f"{point.group.start} start")
+        top.set(ylabel="βP d²", title=f"N = 128², φ = {phi:.3f}")
+        bottom.set(xlabel="collisions per disk", ylabel="|Ψ₆|")
+        top.legend(fontsize=7)
+        bottom.legend(fontsize=7)
+    publish(fig, "melting_starts", out, results)
+
+
 def draw_bond_order(points_done, out, results):
     """The last snapshot of the N = 128² run nearest φ = 0.708 with every disk coloured by
     the phase of its ψ₆, and g₆(r) of the last snapshot of every N = 128² run."""
@@ -538,7 +576,9 @@ def summarise(todo, out, results):
     found = extrema(measured)
     write_markdown(records, found, results)
     draw_equation_of_state(measured, out, results)
-    draw_bond_order([p for p in todo if "bPd2" in (_record(p) or {})], out, results)
+    analysed = [p for p in todo if "bPd2" in (_record(p) or {})]
+    draw_bond_order(analysed, out, results)
+    draw_starts(todo, out, results)
     hours, _ = _cost(records)
     summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
