@@ -12,8 +12,9 @@ at most the group's ``target``, the blocking has converged, the means of the pro
 halves agree within :data:`DRIFT` standard errors and :data:`PRODUCTION_BLOCKS` blocks are
 kept. Otherwise it is resumed to the length its error asks for (:func:`next_length`), at most
 ``longest`` collisions per disk; a point that reaches it stays as it is, its error in the
-tables. The rounds' runs go to joblib's worker processes (``--jobs``), or with ``--cluster
-slurm`` to SLURM through submitit, a job per run.
+tables. The runs go to a pool of ``--jobs`` worker processes, the longest first, each point
+given its next run as soon as one ends; or with ``--cluster slurm``, in rounds of jobs, to
+SLURM through submitit.
 
 Interrupted (Ctrl-C, a killed job, the end of a session), the study starts again where it
 was: a run resumes from its last checkpoint (written every 30 s of wall time and at every
@@ -271,29 +272,78 @@ def _pending(todo):
     return rounds
 
 
-def _execute(rounds, jobs, cluster, out, partition=None):
-    if cluster is None:
-        from joblib import Parallel, delayed
-        # no run queued beyond those running: a study whose parent is gone starts no more
-        return Parallel(n_jobs=jobs, pre_dispatch="n_jobs")(delayed(advance)(p, c)
-                                                            for p, c in rounds)
+def _cost_of(round_):
+    point, collisions_per_disk = round_
+    return point.group.n * collisions_per_disk
+
+
+def _report(point, record):
+    print(f"melting: {point.folder.name} at {record['collisions_per_disk']:.3g} collisions "
+          f"per disk: " + (f"βP d² = {record['bPd2']:.4f} ± {record['err']:.4f}, "
+                           f"{status(point, record)}" if "bPd2" in record
+                           else f"failed: {record['failed']}"), flush=True)
+
+
+def _run_here(todo):
+    """Every point's rounds in this process, the longest first."""
+    while rounds := _pending(todo):
+        point, collisions_per_disk = max(rounds, key=_cost_of)
+        _report(point, advance(point, collisions_per_disk))
+
+
+def _run_in_pool(todo, jobs):
+    """Every point's rounds in ``jobs`` worker processes (spawned: the engine compiles in
+    each, from numba's cache), the longest first; a point whose round ends is given its
+    next at once, and no more runs are handed out than there are workers, so that a study
+    stopped starts none."""
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from multiprocessing import get_context
+
+    waiting = sorted(_pending(todo), key=_cost_of)
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+        running = {}
+        while waiting or running:
+            while waiting and len(running) < jobs:
+                point, collisions_per_disk = waiting.pop()
+                running[pool.submit(advance, point, collisions_per_disk)] = point
+            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in finished:
+                point = running.pop(future)
+                record = future.result()  # KeyboardInterrupt: its run stopped at a signal
+                _report(point, record)
+                if (length := next_length(point, record)) is not None:
+                    waiting.append((point, length))
+                    waiting.sort(key=_cost_of)
+
+
+def _run_on_cluster(todo, cluster, out, partition):
+    """Rounds of every point's next run, each a job of ``cluster`` through submitit (a
+    SLURM array, or local processes with ``local``)."""
     import submitit
+
     executor = submitit.AutoExecutor(folder=Path(out) / "submitit", cluster=cluster)
     executor.update_parameters(timeout_min=24 * 60, cpus_per_task=1,
                                **({"slurm_partition": partition} if partition else {}))
-    submitted = executor.map_array(advance, *zip(*rounds, strict=True))
-    return [job.result() for job in submitted]
+    while rounds := _pending(todo):
+        print(f"melting: a round of {len(rounds)} jobs, "
+              f"{sum(map(_cost_of, rounds)):.3g} collisions", flush=True)
+        for (point, _), job in zip(rounds, executor.map_array(advance, *zip(*rounds,
+                                                                          strict=True)),
+                                   strict=True):
+            _report(point, job.result())
 
 
 def simulate(plan, out, jobs, cluster=None, partition=None):
-    """Rounds of :func:`advance` until no point of ``plan`` has one to run; the longest
-    points first in every round."""
+    """Run every point of ``plan`` until it has no more run to make (:func:`next_length`):
+    in this process (``jobs`` 1), in a pool of ``jobs`` processes, or through submitit on
+    ``cluster``."""
     todo = points(plan, out)
-    while rounds := _pending(todo):
-        rounds.sort(key=lambda pc: -pc[0].group.n * pc[1])
-        print(f"melting: a round of {len(rounds)} runs, "
-              f"{sum(p.group.n * c for p, c in rounds):.3g} collisions", flush=True)
-        _execute(rounds, jobs, cluster, out, partition)
+    if cluster is not None:
+        _run_on_cluster(todo, cluster, out, partition)
+    elif jobs == 1:
+        _run_here(todo)
+    else:
+        _run_in_pool(todo, jobs)
 
 
 # ---------------------------------------------------------------------------- the results
