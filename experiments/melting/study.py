@@ -93,8 +93,8 @@ class Group:
 
 
 #: the published sizes and boxes (Li et al. 2022), with the published points dense where the
-#: curves bend; N = 128² at the points of its MPMC data, the loop's maximum (0.704) and
-#: minimum (0.716) from both starts
+#: curves bend; N = 128² at the points of its MPMC data, the loop's maximum (0.704) and its
+#: lowest published point (0.716, the last: the minimum lies beyond) from both starts
 PLAN = (
     Group("72-square", 72, "1:1", (0.650, 0.660, 0.670, 0.680, 0.686, 0.690, 0.694, 0.698,
                                    0.702, 0.706, 0.710, 0.720),
