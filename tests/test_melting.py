@@ -4,6 +4,7 @@ published, and a short run of the study's state point (its long run is the valid
 
 import csv
 import importlib.util
+import sys
 from pathlib import Path
 
 import h5py
@@ -51,6 +52,9 @@ STUDY = Path(__file__).parents[1] / "experiments" / "melting" / "study.py"
 
 
 def _study():
+    """The study's module, its sibling modules (plan, tables, figures) importable."""
+    if str(STUDY.parent) not in sys.path:
+        sys.path.insert(0, str(STUDY.parent))
     spec = importlib.util.spec_from_file_location("melting_study", STUDY)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -63,7 +67,8 @@ def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_t
     first chunk is resumed, not begun again, and ends on the bits of a study never
     interrupted; a second study with every point done runs nothing and rewrites no run."""
     study = _study()
-    first = study.points(study.QUICK, tmp_path / "cut")[0]
+    plan = sys.modules["plan"]
+    first = plan.points(plan.QUICK, tmp_path / "cut")[0]
     with monkeypatch.context() as patch:  # a signal before the first chunk ends
         patch.setattr(Interruption, "requested", property(lambda self: True))
         patch.setattr(Interruption, "reason", property(lambda self: "interrupted"))
@@ -73,7 +78,7 @@ def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_t
     for out in ("cut", "whole"):
         assert study.main(["--quick", "--jobs", "1", "--out", str(tmp_path / out),
                            "--results", str(tmp_path / out / "results")]) == 0
-    for point in study.points(study.QUICK, tmp_path / "cut"):
+    for point in plan.points(plan.QUICK, tmp_path / "cut"):
         whole = tmp_path / "whole" / point.folder.relative_to(tmp_path / "cut") / "run.h5"
         with h5py.File(point.folder / "run.h5") as a, h5py.File(whole) as b:
             for name in ("particles/disks/position/value", "observables/collision_virial/value"):
@@ -99,8 +104,9 @@ def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_sho
     failed; else its error's ask (with the margin), within the growth's bounds, whole
     blocks."""
     study = _study()
-    group = study.Group("g", 72, "1:1", (0.65,), "compressed", 100, 10_000, 100_000, 0.01)
-    point = study.Point(group, 0.65, Path("unused"))
+    plan = sys.modules["plan"]
+    group = plan.Group("g", 72, "1:1", (0.65,), "compressed", 100, 10_000, 100_000, 0.01)
+    point = plan.Point(group, 0.65, Path("unused"))
     record = {"collisions_per_disk": 10_000, "err": 0.01, "converged": True, "drift": 0.5,
               "blocks": 100, "cut": 0}
     assert study.status(point, record) == "done" and study.next_length(point, record) is None

@@ -1,0 +1,91 @@
+"""The plan of the melting study (:mod:`study`): its groups of state points at the
+published sizes, boxes and packing fractions, the rules that end a point's runs, and the
+points with their run folders."""
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from sim.checks.melting import reference
+
+#: the drift of the production's halves, in standard errors, below which a run is stationary
+DRIFT = 3.0
+#: a round resumes a point to this many times the length its error asks for
+MARGIN = 1.3
+#: and to at least 1.5, at most 4 times its length so far
+GROWTH = (1.5, 4.0)
+#: the fewest production blocks of a point done: blocking has three levels of 8 and more
+PRODUCTION_BLOCKS = 64
+
+
+@dataclass(frozen=True)
+class Group:
+    """State points of one N and box: ``phis`` (published packing fractions), started as
+    ``start`` (``compressed``: a random gas compressed by growing disks; ``melted``: a
+    hexagonal lattice melted by a short elastic run); a snapshot, one block of the
+    pressure, every ``block`` collisions per disk; ``first`` collisions per disk in the first
+    round, at most ``longest``; done at an error of βP d² of at most ``target``."""
+
+    name: str
+    n: int
+    box: str
+    phis: tuple
+    start: str
+    block: int
+    first: int
+    longest: int
+    target: float
+
+
+#: the published sizes and boxes (Li et al. 2022), with the published points dense where the
+#: curves bend; N = 128² at the points of its MPMC data, the loop's maximum (0.704) and its
+#: lowest published point (0.716, the last: the minimum lies beyond) from both starts
+PLAN = (
+    Group("72-square", 72, "1:1", (0.650, 0.660, 0.670, 0.680, 0.686, 0.690, 0.694, 0.698,
+                                   0.702, 0.706, 0.710, 0.720),
+          "compressed", 1000, 1_000_000, 30_000_000, 0.002),
+    Group("72-lattice", 72, "9:8√3/2", (0.650, 0.670, 0.680, 0.684, 0.686, 0.688, 0.690,
+                                        0.692, 0.694, 0.696, 0.698, 0.700, 0.706, 0.720),
+          "compressed", 1000, 1_000_000, 30_000_000, 0.002),
+    Group("224-square", 224, "1:1", (0.670, 0.680, 0.686, 0.690, 0.692, 0.694, 0.698, 0.702,
+                                     0.704, 0.706, 0.708, 0.712, 0.720),
+          "compressed", 500, 300_000, 10_000_000, 0.003),
+    Group("870-square", 870, "1:1", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706, 0.710,
+                                     0.712, 0.714, 0.716, 0.718),
+          "compressed", 200, 100_000, 3_000_000, 0.003),
+    Group("870-lattice", 870, "29:30√3/2", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706,
+                                            0.710, 0.712, 0.714, 0.716, 0.718),
+          "compressed", 200, 100_000, 3_000_000, 0.003),
+    Group("16384-square", 16384, "1:1", (0.698, 0.704, 0.708, 0.712, 0.716),
+          "compressed", 1000, 80_000, 400_000, 0.003),
+    Group("16384-square-melted", 16384, "1:1", (0.704, 0.716),
+          "melted", 1000, 80_000, 400_000, 0.003),
+)
+
+#: a smoke run of the study: two points of N = 72, short, into a folder of the caller's
+QUICK = (Group("72-square", 72, "1:1", (0.650, 0.700), "compressed", 500, 10_000, 20_000,
+               0.05),)
+
+
+@dataclass(frozen=True)
+class Point:
+    """One state point: its group and packing fraction, and its run folder."""
+
+    group: Group
+    phi: float
+    folder: Path
+
+    @property
+    def aspect(self):
+        return reference(self.group.n, self.group.box)[3]
+
+    def overrides(self, collisions_per_disk):
+        g = self.group
+        return ["scenario=melting", f"disks.n={g.n}", f"disks.packing_fraction={self.phi}",
+                f"box.size=[{self.aspect!r},1.0]", f"disks.placement={g.start}",
+                f"stop.collisions={collisions_per_disk * g.n}",
+                f"output.every_collisions={g.block * g.n}", "output.progress=false"]
+
+
+def points(plan, out):
+    return [Point(g, phi, Path(out) / "runs" / f"{g.name}-{phi:.3f}") for g in plan
+            for phi in g.phis]

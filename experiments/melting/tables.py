@@ -1,0 +1,139 @@
+"""The melting study's results as data: the tables (melting.csv, melting_reference.csv), the
+loops' extrema, melting.md with every run against its published value, and files written
+whole."""
+
+import csv
+import math
+import os
+
+import numpy as np
+from plan import DRIFT, GROWTH, MARGIN, PLAN, PRODUCTION_BLOCKS
+
+from sim.checks.melting import loop_extrema, reference
+
+
+def write_whole(path, text):
+    """``text`` into ``path`` whole or not at all (a signal between the two leaves the old)."""
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(text)
+    os.replace(partial, path)
+
+
+def write_tables(records, results):
+    """melting.csv and melting_reference.csv, one row per run."""
+    columns = ("n", "aspect", "phi", "start", "collisions_per_disk", "bPd2", "err", "psi6")
+    with open(results / "melting.csv", "w", newline="", encoding="utf-8") as file:
+        writer = csv.writer(file)
+        writer.writerow(columns)
+        for r in records:
+            writer.writerow([r["n"], f"{r['aspect']:.12g}", f"{r['phi']:.3f}", r["start"],
+                             f"{r['collisions_per_disk']:.0f}", f"{r['bPd2']:.5f}",
+                             f"{r['err']:.5f}", f"{r['psi6']:.4f}"])
+    with open(results / "melting_reference.csv", "w", newline="", encoding="utf-8") as file:
+        writer = csv.writer(file)
+        writer.writerow(("n", "box", "aspect", "phi", "bPd2", "err", "source"))
+        for r in records:
+            phi, pressure, error, _ = reference(r["n"], r["box"])
+            k = int(np.argmin(np.abs(phi - r["phi"])))
+            writer.writerow([r["n"], r["box"], f"{r['aspect']:.12g}", f"{r['phi']:.3f}",
+                             pressure[k], error[k], SOURCE])
+
+
+SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157, 234111 (2022), "
+          "data of jellyfysh/HistoricDisks")
+
+
+def extrema(records):
+    """Per group with a loop in its published curve: the published maximum and minimum from
+    all its points and from those at our φ only, and ours (:func:`loop_extrema`), where our
+    points show one. The vertex of a parabola depends on the points fitted: ours compare
+    with the published ones at our φ."""
+    found = {}
+    for name in dict.fromkeys(r["group"] for r in records):
+        mine = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
+        phi, pressure, error, _ = reference(mine[0]["n"], mine[0]["box"])
+        published = loop_extrema(phi, pressure, error)
+        if published is None:
+            continue
+        ours = np.array([[r[k] for k in ("phi", "bPd2", "err")] for r in mine]).T
+        same = np.isin(np.round(phi, 3), np.round(ours[0], 3))
+        found[name] = {"published": published,
+                       "published_at_our_phi": loop_extrema(*(x[same] for x in
+                                                              (phi, pressure, error))),
+                       "sim": loop_extrema(*ours)}
+    return found
+
+
+def processor_hours(records):
+    """Processor hours per group, and what a point of N = 256² at the points of N = 128²
+    would cost at least: four times the disks, the same collisions per disk at the rate of
+    N = 128² (its points done)."""
+    hours = {}
+    for r in records:
+        hours[r["group"]] = hours.get(r["group"], 0.0) + r["cpu_seconds"] / 3600.0
+    large = [r for r in records if r["n"] == 16384 and r.get("status") == "done"]
+    large_point_hours = (4.0 * sum(r["cpu_seconds"] for r in large) / len(large) / 3600.0
+                         if large else None)
+    return hours, large_point_hours
+
+
+def _extreme(e):
+    return "none in the points" if e is None else \
+        f"{e[0]:.4f} ± {e[1]:.4f}, {e[2]:.4f} ± {e[3]:.4f}"
+
+
+def write_markdown(records, found, results):
+    """melting.md: every run against the published value of its N and box, with its state,
+    the loops' extrema, the processor hours."""
+    lines = [f"A point is done when the blocking error of βP d² over its production is at "
+             f"most its group's target, the blocking has converged, the means of the "
+             f"production's halves differ by less than {DRIFT:g} standard errors and at "
+             f"least {PRODUCTION_BLOCKS} blocks are kept; else it runs on to {MARGIN:g} times "
+             f"the length its error asks for ({GROWTH[0]:g} to {GROWTH[1]:g} times its "
+             f"length so far). Targets: "
+             + "; ".join(f"{g.name} {g.target:g} (a block every {g.block} collisions per "
+                         f"disk, at most {g.longest:.3g})" for g in PLAN) + ".", ""]
+    measured = [r for r in records if "bPd2" in r]
+    for name in dict.fromkeys(r["group"] for r in measured):
+        rows = sorted((r for r in measured if r["group"] == name), key=lambda r: r["phi"])
+        phi, pressure, error, _ = reference(rows[0]["n"], rows[0]["box"])
+        lines += [f"**N = {rows[0]['n']}, box {rows[0]['box']}, {rows[0]['start']} start**",
+                  "", "| φ | βP d², sim | published | difference / combined error | "
+                  "collisions per disk | equilibration cut | drift | ⟨|Ψ₆|⟩ | state |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for r in rows:
+            k = int(np.argmin(np.abs(phi - r["phi"])))
+            z = (r["bPd2"] - pressure[k]) / math.hypot(r["err"], error[k])
+            lines.append(f"| {r['phi']:.3f} | {r['bPd2']:.4f} ± {r['err']:.4f} | "
+                         f"{pressure[k]:.4f} ± {error[k]:.4f} | {z:+.1f} | "
+                         f"{r['collisions_per_disk']:.3g} | {r['cut']} of "
+                         f"{r['cut'] + r['blocks']} blocks | {r['drift']:+.1f} | "
+                         f"{r['psi6']:.3f} | {r['status']} |")
+        lines.append("")
+    for r in records:
+        if "failed" in r:
+            lines += [f"Failed: N = {r['n']}, box {r['box']}, φ = {r['phi']:.3f}: "
+                      f"{r['failed']}.", ""]
+    if found:
+        lines += ["**The loops' extrema** (a parabola through the five points about each; "
+                  "errors: half the 16–84 % range over resamplings of the points within "
+                  "their errors). The published ones from all their points, and from those "
+                  "at the φ of the runs, which compare with ours.", "",
+                  "| N, box | | maximum: φ, βP d² | minimum: φ, βP d² |",
+                  "| --- | --- | --- | --- |"]
+        for name, all_three in found.items():
+            for label, key in (("published, all points", "published"),
+                               ("published, at our φ", "published_at_our_phi"),
+                               ("sim", "sim")):
+                e = all_three[key] or {"max": None, "min": None}
+                lines.append(f"| {name} | {label} | {_extreme(e['max'])} | "
+                             f"{_extreme(e['min'])} |")
+        lines.append("")
+    hours, large_point_hours = processor_hours(records)
+    lines.append("Processor hours: " + "; ".join(f"{k} {v:.2f}" for k, v in hours.items())
+                 + f"; in all {sum(hours.values()):.2f}.")
+    if large_point_hours is not None:
+        lines.append(f"N = 256² would take at least {large_point_hours:.2f} processor hours "
+                     f"per state point (four times the disks of N = 128² at the same "
+                     f"collisions per disk; its slower relaxation would ask for more).")
+    write_whole(results / "melting.md", "\n".join(lines) + "\n")
