@@ -40,6 +40,7 @@ import argparse
 import json
 import math
 import os
+import signal
 import sys
 import time
 from dataclasses import asdict
@@ -209,26 +210,39 @@ def _run_here(todo):
 def _run_in_pool(todo, jobs):
     """Every point's rounds in ``jobs`` worker processes (spawned: the engine compiles in
     each, from numba's cache), the longest first; a point whose round ends is given its
-    next at once, and no more runs are handed out than there are workers, so that a study
-    stopped starts none."""
+    next at once, and no more runs are handed out than there are workers. Stopped by
+    SIGINT or SIGTERM (to this process alone or to its group), it asks its workers to stop
+    their runs, which write their checkpoints, and raises KeyboardInterrupt."""
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-    from multiprocessing import get_context
+    from multiprocessing import active_children, get_context
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
 
     waiting = sorted(_pending(todo), key=_cost_of)
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-        running = {}
-        while waiting or running:
-            while waiting and len(running) < jobs:
-                point, collisions_per_disk = waiting.pop()
-                running[pool.submit(advance, point, collisions_per_disk)] = point
-            finished, _ = wait(running, return_when=FIRST_COMPLETED)
-            for future in finished:
-                point = running.pop(future)
-                record = future.result()  # KeyboardInterrupt: its run stopped at a signal
-                _report(point, record)
-                if (length := next_length(point, record)) is not None:
-                    waiting.append((point, length))
-                    waiting.sort(key=_cost_of)
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+            running = {}
+            try:
+                while waiting or running:
+                    while waiting and len(running) < jobs:
+                        point, collisions_per_disk = waiting.pop()
+                        running[pool.submit(advance, point, collisions_per_disk)] = point
+                    finished, _ = wait(running, return_when=FIRST_COMPLETED)
+                    for future in finished:
+                        point = running.pop(future)
+                        record = future.result()  # KeyboardInterrupt: a run stopped
+                        _report(point, record)
+                        if (length := next_length(point, record)) is not None:
+                            waiting.append((point, length))
+                            waiting.sort(key=_cost_of)
+            except KeyboardInterrupt:
+                for worker in active_children():  # each run stops at its next chunk
+                    os.kill(worker.pid, signal.SIGINT)
+                raise
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _run_on_cluster(todo, cluster, out, partition):
