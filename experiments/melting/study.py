@@ -267,6 +267,11 @@ def simulate(plan, out, jobs, cluster=None, partition=None):
     in this process (``jobs`` 1), in a pool of ``jobs`` processes, or through submitit on
     ``cluster``."""
     todo = points(plan, out)
+    states = [status(p, r) if (r := _record(p)) is not None else "not begun" for p in todo]
+    print("melting: " + ", ".join(f"{states.count(state)} {state}" for state in
+                                  ("done", "running", "not begun", "longest", "failed")
+                                  if state in states) + f" of {len(todo)} points",
+          flush=True)
     if cluster is not None:
         _run_on_cluster(todo, cluster, out, partition)
     elif jobs == 1:
