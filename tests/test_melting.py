@@ -100,9 +100,9 @@ def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_t
 
 
 def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_should():
-    """next_length: none for a point that meets its target, has reached its longest run or
-    failed; else its error's ask (with the margin), within the growth's bounds, whole
-    blocks."""
+    """next_length: none for a point that meets its target (and agrees with the runs of its
+    state point from other starts), has reached its longest run or failed; else its
+    error's ask (with the margin), within the growth's bounds, whole blocks."""
     study = _study()
     plan = sys.modules["plan"]
     group = plan.Group("g", 72, "1:1", (0.65,), "compressed", 100, 10_000, 100_000, 0.01)
@@ -125,5 +125,11 @@ def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_sho
     longest = dict(far, collisions_per_disk=100_000)
     assert study.status(point, longest) == "longest"
     assert study.next_length(point, longest) is None
+    record = dict(record, bPd2=9.0)  # beside a run of the same point from another start
+    assert study.status(point, record, [{"bPd2": 9.0 + 2.9 * 0.01 * 2**0.5, "err": 0.01}]) \
+        == "done"
+    apart = [{"bPd2": 9.0 + 3.1 * 0.01 * 2**0.5, "err": 0.01}]
+    assert study.status(point, record, apart) == "running"
+    assert study.next_length(point, record, apart) == 15_000
     failed = {"collisions_per_disk": 5_000, "failed": "a run to its collisions"}
     assert study.status(point, failed) == "failed" and study.next_length(point, failed) is None

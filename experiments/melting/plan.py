@@ -15,6 +15,9 @@ MARGIN = 1.3
 GROWTH = (1.5, 4.0)
 #: the fewest production blocks of a point done: blocking has three levels of 8 and more
 PRODUCTION_BLOCKS = 64
+#: runs of one state point from different starts agree when they differ by at most this many
+#: combined standard errors; until they do, both run on
+AGREEMENT = 3.0
 
 
 @dataclass(frozen=True)
@@ -89,3 +92,10 @@ class Point:
 def points(plan, out):
     return [Point(g, phi, Path(out) / "runs" / f"{g.name}-{phi:.3f}") for g in plan
             for phi in g.phis]
+
+
+def twins(point, todo):
+    """The points of ``todo`` at the state point of ``point`` (N, box, φ) from other starts."""
+    return [other for other in todo if other.group.start != point.group.start
+            and (other.group.n, other.group.box, other.phi)
+            == (point.group.n, point.group.box, point.phi)]

@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 from figures import draw_bond_order, draw_equation_of_state, draw_starts
 from plan import (
+    AGREEMENT,
     DRIFT,
     GROWTH,
     MARGIN,
@@ -56,6 +57,7 @@ from plan import (
     PRODUCTION_BLOCKS,
     QUICK,
     points,
+    twins,
 )
 from tables import extrema, processor_hours, write_markdown, write_tables, write_whole
 
@@ -77,28 +79,42 @@ def _record(point):
 
 def reached(point, record):
     """Whether the point's run meets its group's target: error, convergence, no drift and
-    :data:`PRODUCTION_BLOCKS` blocks kept."""
+    ``PRODUCTION_BLOCKS`` blocks kept."""
     return (record["err"] <= point.group.target and record["converged"]
             and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS)
 
 
-def status(point, record):
-    """``done``, ``longest`` (run to its group's longest, its target missed), ``failed``
-    (the reason in its record) or ``running``."""
+def agrees(record, others):
+    """Whether the run's βP d² agrees with that of every run of the same state point from
+    another start (``others``: their records) within ``AGREEMENT`` combined errors."""
+    return all(abs(record["bPd2"] - other["bPd2"])
+               <= AGREEMENT * math.hypot(record["err"], other["err"])
+               for other in others if "bPd2" in other)
+
+
+def status(point, record, others=()):
+    """``done`` (its target met, and its βP d² that of the runs from other starts,
+    ``others``: their records), ``longest`` (run to its group's longest, not done),
+    ``failed`` (the reason in its record) or ``running``."""
     if "failed" in record:
         return "failed"
-    if reached(point, record):
+    if reached(point, record) and agrees(record, others):
         return "done"
     return "longest" if record["collisions_per_disk"] >= point.group.longest else "running"
 
 
-def next_length(point, record):
+def _others(point, todo):
+    """The records of ``point``'s twins (:func:`plan.twins`) in ``todo``."""
+    return [r for twin in twins(point, todo) if (r := _record(twin)) is not None]
+
+
+def next_length(point, record, others=()):
     """Collisions per disk the point runs to in its next round, or None when it has none
-    (:func:`status` other than ``running``): the length its error asks for, to
-    :data:`MARGIN`, from :data:`GROWTH` [0] to [1] times its length so far, at most its
-    group's longest, a whole number of blocks."""
+    (:func:`status` other than ``running``): the length its error asks for, to ``MARGIN``,
+    from ``GROWTH`` [0] to [1] times its length so far, at most its group's longest, a
+    whole number of blocks."""
     g = point.group
-    if status(point, record) != "running":
+    if status(point, record, others) != "running":
         return None
     length = record["collisions_per_disk"]
     production = length * record["blocks"] / (record["blocks"] + record["cut"])
@@ -183,7 +199,7 @@ def _pending(todo):
                 rounds.append((point, stored.stop.collisions // point.group.n))
             else:
                 rounds.append((point, point.group.first))
-        elif (length := next_length(point, record)) is not None:
+        elif (length := next_length(point, record, _others(point, todo))) is not None:
             rounds.append((point, length))
     return rounds
 
@@ -193,10 +209,10 @@ def _cost_of(round_):
     return point.group.n * collisions_per_disk
 
 
-def _report(point, record):
+def _report(point, record, others):
     print(f"melting: {point.folder.name} at {record['collisions_per_disk']:.3g} collisions "
           f"per disk: " + (f"βP d² = {record['bPd2']:.4f} ± {record['err']:.4f}, "
-                           f"{status(point, record)}" if "bPd2" in record
+                           f"{status(point, record, others)}" if "bPd2" in record
                            else f"failed: {record['failed']}"), flush=True)
 
 
@@ -204,7 +220,7 @@ def _run_here(todo):
     """Every point's rounds in this process, the longest first."""
     while rounds := _pending(todo):
         point, collisions_per_disk = max(rounds, key=_cost_of)
-        _report(point, advance(point, collisions_per_disk))
+        _report(point, advance(point, collisions_per_disk), _others(point, todo))
 
 
 def _run_in_pool(todo, jobs):
@@ -233,10 +249,17 @@ def _run_in_pool(todo, jobs):
                     for future in finished:
                         point = running.pop(future)
                         record = future.result()  # KeyboardInterrupt: a run stopped
-                        _report(point, record)
-                        if (length := next_length(point, record)) is not None:
-                            waiting.append((point, length))
-                            waiting.sort(key=_cost_of)
+                        _report(point, record, _others(point, todo))
+                        busy = {p.folder for p in running.values()} | {p.folder for p, _ in
+                                                                       waiting}
+                        # the point, and its twins: one done may no longer agree with it
+                        for again in (point, *twins(point, todo)):
+                            if again.folder in busy or (last := _record(again)) is None:
+                                continue
+                            length = next_length(again, last, _others(again, todo))
+                            if length is not None:
+                                waiting.append((again, length))
+                        waiting.sort(key=_cost_of)
             except KeyboardInterrupt:
                 for worker in active_children():  # each run stops at its next chunk
                     os.kill(worker.pid, signal.SIGINT)
@@ -267,7 +290,8 @@ def simulate(plan, out, jobs, cluster=None, partition=None):
     in this process (``jobs`` 1), in a pool of ``jobs`` processes, or through submitit on
     ``cluster``."""
     todo = points(plan, out)
-    states = [status(p, r) if (r := _record(p)) is not None else "not begun" for p in todo]
+    states = [status(p, r, _others(p, todo)) if (r := _record(p)) is not None
+              else "not begun" for p in todo]
     print("melting: " + ", ".join(f"{states.count(state)} {state}" for state in
                                   ("done", "running", "not begun", "longest", "failed")
                                   if state in states) + f" of {len(todo)} points",
@@ -283,7 +307,7 @@ def simulate(plan, out, jobs, cluster=None, partition=None):
 def summarise(todo, out, results):
     """The tables, the figures, melting.md and melting.json of the points of ``todo`` that
     have a record, each with its :func:`status`."""
-    records = [dict(record, status=status(p, record)) for p in todo
+    records = [dict(record, status=status(p, record, _others(p, todo))) for p in todo
                if (record := _record(p)) is not None]
     measured = [r for r in records if "bPd2" in r]
     results.mkdir(parents=True, exist_ok=True)
@@ -298,7 +322,7 @@ def summarise(todo, out, results):
     summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
                "rules": {"drift": DRIFT, "margin": MARGIN, "growth": GROWTH,
-                         "production_blocks": PRODUCTION_BLOCKS}}
+                         "production_blocks": PRODUCTION_BLOCKS, "agreement": AGREEMENT}}
     write_whole(results / "melting.json", json.dumps(summary, indent=1, default=float))
     print(f"melting: {len(records)} points, {sum(hours.values()):.2f} processor hours, "
           f"into {results}")

@@ -7,7 +7,7 @@ import math
 import os
 
 import numpy as np
-from plan import DRIFT, GROWTH, MARGIN, PLAN, PRODUCTION_BLOCKS
+from plan import AGREEMENT, DRIFT, GROWTH, MARGIN, PLAN, PRODUCTION_BLOCKS
 
 from sim.checks.melting import loop_extrema, reference
 
@@ -87,8 +87,10 @@ def write_markdown(records, found, results):
     the loops' extrema, the processor hours."""
     lines = [f"A point is done when the blocking error of βP d² over its production is at "
              f"most its group's target, the blocking has converged, the means of the "
-             f"production's halves differ by less than {DRIFT:g} standard errors and at "
-             f"least {PRODUCTION_BLOCKS} blocks are kept; else it runs on to {MARGIN:g} times "
+             f"production's halves differ by less than {DRIFT:g} standard errors, at "
+             f"least {PRODUCTION_BLOCKS} blocks are kept and its βP d² agrees with that of "
+             f"the runs of the same state point from other starts within {AGREEMENT:g} "
+             f"combined standard errors; else it runs on to {MARGIN:g} times "
              f"the length its error asks for ({GROWTH[0]:g} to {GROWTH[1]:g} times its "
              f"length so far). Targets: "
              + "; ".join(f"{g.name} {g.target:g} (a block every {g.block} collisions per "
