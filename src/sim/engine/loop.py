@@ -126,11 +126,11 @@ def predict(i, t, disks, schedule, neighbours, box, effects, pair, t_origin):
 
     The same rule bounds the search: a pair's event is looked for only before
     min(τ, t_j − t) (never below 0: t_j may lie before t by round-off), τ the earliest event
-    found so far and t_j j's next event, so that the
-    filter of the pair's rule (:func:`sim.engine.kinematics.may_touch_before` for hard
-    cores) spares the root of every contact that would be left out anyway. In a dense gas,
-    where most neighbours are about to collide with a disk of their own, that is most of
-    them: ``compare_builds.py`` 1.143 at N = 16384, φ = 0.708.
+    found so far and t_j j's next event, so that the filter of the pair's rule
+    (:func:`sim.engine.kinematics.may_touch_before` for hard cores) spares the root of every
+    contact that would be left out anyway. In a dense gas, where most neighbours are about
+    to collide with a disk of their own, that is most of them: ``compare_builds.py`` 1.143
+    at N = 16384, φ = 0.708.
     """
     table = disks.table
     geometry, grid = box
