@@ -59,13 +59,14 @@ from plan import (
     points,
     twins,
 )
-from tables import extrema, processor_hours, write_markdown, write_tables, write_whole
+from tables import extrema, processor_hours, write_markdown, write_tables
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
 from sim.pipeline.resume import resume, stored_config
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
+from sim.storage.whole_file import whole_file
 
 #: the version of :func:`analyse`'s rules a record was made with; a record of another is
 #: made anew from its run file when the study starts
@@ -150,7 +151,8 @@ def _spend(point, seconds):
     path = point.folder / "cpu_seconds"
     before = (float(path.read_text()) if path.exists()
               else (_record(point) or {}).get("cpu_seconds", 0.0))
-    write_whole(path, repr(before + seconds))
+    with whole_file(path) as partial:
+        partial.write_text(repr(before + seconds))
 
 
 def analyse(point):
@@ -182,7 +184,8 @@ def analyse(point):
             record |= {"bPd2": eos.mean, "err": eos.error, "converged": bool(eos.converged),
                        "cut": eos.cut, "blocks": eos.blocks, "drift": eos.drift,
                        "psi6": float(np.mean(psi))}
-    write_whole(point.folder / "point.json", json.dumps(record, indent=1))
+    with whole_file(point.folder / "point.json") as partial:
+        partial.write_text(json.dumps(record, indent=1))
     return record
 
 
@@ -323,7 +326,8 @@ def summarise(todo, out, results):
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
                "rules": {"drift": DRIFT, "margin": MARGIN, "growth": GROWTH,
                          "production_blocks": PRODUCTION_BLOCKS, "agreement": AGREEMENT}}
-    write_whole(results / "melting.json", json.dumps(summary, indent=1, default=float))
+    with whole_file(results / "melting.json") as partial:
+        partial.write_text(json.dumps(summary, indent=1, default=float))
     print(f"melting: {len(records)} points, {sum(hours.values()):.2f} processor hours, "
           f"into {results}")
 

@@ -4,32 +4,27 @@ whole."""
 
 import csv
 import math
-import os
 
 import numpy as np
 from plan import AGREEMENT, DRIFT, GROWTH, MARGIN, PLAN, PRODUCTION_BLOCKS
 
 from sim.checks.melting import loop_extrema, reference
-
-
-def write_whole(path, text):
-    """``text`` into ``path`` whole or not at all (a signal between the two leaves the old)."""
-    partial = path.with_name(path.name + ".partial")
-    partial.write_text(text)
-    os.replace(partial, path)
+from sim.storage.whole_file import whole_file
 
 
 def write_tables(records, results):
     """melting.csv and melting_reference.csv, one row per run."""
     columns = ("n", "aspect", "phi", "start", "collisions_per_disk", "bPd2", "err", "psi6")
-    with open(results / "melting.csv", "w", newline="", encoding="utf-8") as file:
+    with whole_file(results / "melting.csv") as partial, \
+            open(partial, "w", newline="", encoding="utf-8") as file:
         writer = csv.writer(file)
         writer.writerow(columns)
         for r in records:
             writer.writerow([r["n"], f"{r['aspect']:.12g}", f"{r['phi']:.3f}", r["start"],
                              f"{r['collisions_per_disk']:.0f}", f"{r['bPd2']:.5f}",
                              f"{r['err']:.5f}", f"{r['psi6']:.4f}"])
-    with open(results / "melting_reference.csv", "w", newline="", encoding="utf-8") as file:
+    with whole_file(results / "melting_reference.csv") as partial, \
+            open(partial, "w", newline="", encoding="utf-8") as file:
         writer = csv.writer(file)
         writer.writerow(("n", "box", "aspect", "phi", "bPd2", "err", "source"))
         for r in records:
@@ -138,4 +133,5 @@ def write_markdown(records, found, results):
         lines.append(f"N = 256² would take at least {large_point_hours:.2f} processor hours "
                      f"per state point (four times the disks of N = 128² at the same "
                      f"collisions per disk; its slower relaxation would ask for more).")
-    write_whole(results / "melting.md", "\n".join(lines) + "\n")
+    with whole_file(results / "melting.md") as partial:
+        partial.write_text("\n".join(lines) + "\n", encoding="utf-8")
