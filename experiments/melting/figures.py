@@ -101,7 +101,10 @@ def draw_starts(todo, out, results):
         for point in (p for p in large if p.phi == phi):
             try:
                 run_data = open_run(point.folder / "run.h5")
-            except RunFileError:  # running now, or not begun
+            except RunFileError:  # running now, or not begun: said on the panel
+                top.text(0.02, 0.04 if point.group.start == "compressed" else 0.12,
+                         f"{point.group.start} start: not drawn (running, or not begun)",
+                         transform=top.transAxes, fontsize=7)
                 continue
             with run_data:
                 pressure, ends = block_pressures(run_data)
