@@ -4,6 +4,7 @@ published, and a short run of the study's state point (its long run is the valid
 
 import csv
 import importlib.util
+import json
 import sys
 from pathlib import Path
 
@@ -97,6 +98,31 @@ def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_t
                        "--results", str(tmp_path / "whole" / "results")]) == 0
     assert "collisions per disk:" not in capsys.readouterr().out  # no run reported
     assert [f.stat().st_mtime_ns for f in files] == stamps
+    capsys.readouterr()  # a clone with the results alone goes on from them: nothing to run
+    assert study.main(["--quick", "--jobs", "1", "--out", str(tmp_path / "clone"),
+                       "--results", str(tmp_path / "clone" / "results"), "--ledger",
+                       str(tmp_path / "whole" / "results" / "melting.json")]) == 0
+    assert "collisions per disk:" not in capsys.readouterr().out
+    assert not list((tmp_path / "clone" / "runs").glob("*/run.h5"))
+    with open(tmp_path / "clone" / "results" / "melting.csv", encoding="utf-8") as file:
+        assert list(csv.DictReader(file)) == rows
+
+
+def test_a_committed_record_of_older_rules_is_run_again_to_its_recorded_length(tmp_path):
+    """adopt: a point with neither record nor run here takes the committed one; one made by
+    an older analysis, its run file not here, is run again from its start to its length."""
+    study = _study()
+    plan = sys.modules["plan"]
+    point = plan.points(plan.QUICK, tmp_path)[0]
+    g = point.group
+    older = {"group": g.name, "n": g.n, "box": g.box, "phi": point.phi, "start": g.start,
+             "analysis": study.ANALYSIS - 1, "collisions_per_disk": 3 * g.first,
+             "cpu_seconds": 5.0, "status": "done"}
+    ledger = tmp_path / "melting.json"
+    ledger.write_text(json.dumps({"points": [older]}))
+    study.adopt([point], ledger)
+    assert json.loads((point.folder / "point.json").read_text())["cpu_seconds"] == 5.0
+    assert study._pending([point]) == [(point, 3 * g.first)]
 
 
 def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_should():

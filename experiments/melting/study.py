@@ -47,7 +47,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
-from figures import draw_bond_order, draw_equation_of_state, draw_starts
+from figures import TRACED, draw_bond_order, draw_equation_of_state, draw_starts, trace
 from plan import (
     AGREEMENT,
     DRIFT,
@@ -68,6 +68,8 @@ from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 from sim.storage.whole_file import whole_file
 
+#: the committed results, from which a study goes on (:func:`adopt`)
+LEDGER = Path(__file__).resolve().parents[2] / "docs" / "results" / "melting.json"
 #: the version of :func:`analyse`'s rules a record was made with; a record of another is
 #: made anew from its run file when the study starts
 ANALYSIS = 2
@@ -184,9 +186,35 @@ def analyse(point):
             record |= {"bPd2": eos.mean, "err": eos.error, "converged": bool(eos.converged),
                        "cut": eos.cut, "blocks": eos.blocks, "drift": eos.drift,
                        "psi6": float(np.mean(psi))}
+            if (drawn := trace(dataset, g.n)) is not None:
+                record["trace"] = drawn
     with whole_file(point.folder / "point.json") as partial:
         partial.write_text(json.dumps(record, indent=1))
     return record
+
+
+def adopt(todo, ledger):
+    """Take the records of ``ledger`` (the melting.json of an earlier study: for
+    ``make melting`` the committed docs/results/melting.json) for the points of ``todo``
+    that have neither a record nor a run here, so that a fresh clone goes on where the
+    committed results stand. A point done by today's rules (:data:`ANALYSIS`) is not run
+    again, unless the figure of the two starts needs its trace (:func:`figures.trace`);
+    one not done runs from its start to the length its record asks for (the same bits as
+    the run resumed); one of older rules runs again to its recorded length. Their processor
+    seconds count on."""
+    if ledger is None or not ledger.exists():
+        return
+    recorded = {(r["group"], r["n"], r["box"], round(r["phi"], 6), r["start"]): r
+                for r in json.loads(ledger.read_text(encoding="utf-8"))["points"]}
+    for point in todo:
+        g = point.group
+        record = recorded.get((g.name, g.n, g.box, round(point.phi, 6), g.start))
+        if record is None or _record(point) is not None or (point.folder / "run.h5").exists():
+            continue
+        point.folder.mkdir(parents=True, exist_ok=True)
+        record = {k: v for k, v in record.items() if k != "status"}
+        with whole_file(point.folder / "point.json") as partial:
+            partial.write_text(json.dumps(record, indent=1))
 
 
 def _pending(todo):
@@ -194,6 +222,13 @@ def _pending(todo):
     rounds = []
     for point in todo:
         record = _record(point)
+        adopted = record is not None and not (point.folder / "run.h5").exists()
+        if adopted and "failed" not in record and (
+                record.get("analysis") != ANALYSIS  # of older rules
+                or ("trace" not in record and point.group.n == TRACED
+                    and twins(point, todo))):  # the figure of the two starts draws it
+            rounds.append((point, max(point.group.first, int(record["collisions_per_disk"]))))
+            continue
         if record is not None and record.get("analysis") != ANALYSIS:
             record = analyse(point)  # analysed by an older rule: read its run again
         if record is None:
@@ -318,9 +353,8 @@ def summarise(todo, out, results):
     found = extrema(measured)
     write_markdown(records, found, results)
     draw_equation_of_state(measured, out, results)
-    analysed = [p for p in todo if "bPd2" in (_record(p) or {})]
-    draw_bond_order(analysed, out, results)
-    draw_starts(todo, out, results)
+    draw_bond_order(measured, todo, out, results)
+    draw_starts(measured, out, results)
     hours, _ = processor_hours(records)
     summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
@@ -344,6 +378,9 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="a smoke run: two short points")
     parser.add_argument("--report", action="store_true",
                         help="run nothing: the results of the points done so far")
+    parser.add_argument("--ledger", type=Path, default=None,
+                        help="the melting.json of an earlier study to go on from (default: "
+                             "the committed results; none with --quick)")
     args = parser.parse_args(argv)
     plan = QUICK if args.quick else PLAN
     if args.groups:
@@ -352,6 +389,7 @@ def main(argv=None):
             parser.error(f"--groups: {', '.join(sorted(unknown))}: no such group; allowed: "
                          + ", ".join(g.name for g in plan))
         plan = tuple(g for g in plan if g.name in args.groups)
+    adopt(points(plan, args.out), args.ledger or (None if args.quick else LEDGER))
     try:
         if not args.report:
             simulate(plan, args.out, args.jobs, args.cluster, args.partition)

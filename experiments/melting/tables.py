@@ -39,24 +39,33 @@ SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157,
 
 
 def extrema(records):
-    """Per group with a loop in its published curve: the published maximum and minimum from
-    all its points and from those at our φ only, and ours (:func:`loop_extrema`), where our
-    points show one. The vertex of a parabola depends on the points fitted: ours compare
-    with the published ones at our φ."""
+    """Per N and box with a loop in its published curve: the published maximum and minimum
+    from all its points and from those at our φ only, and ours (:func:`loop_extrema`, one
+    run per φ: the first of its starts in ``STARTS``), where our points show one. The vertex
+    of a parabola depends on the points fitted: ours compare with the published ones at our
+    φ."""
     found = {}
-    for name in dict.fromkeys(r["group"] for r in records):
-        mine = sorted((r for r in records if r["group"] == name), key=lambda r: r["phi"])
-        phi, pressure, error, _ = reference(mine[0]["n"], mine[0]["box"])
+    for n, box in dict.fromkeys((r["n"], r["box"]) for r in records):
+        one = {}
+        for r in sorted((r for r in records if (r["n"], r["box"]) == (n, box)),
+                        key=lambda r: STARTS.index(r["start"])):
+            one.setdefault(round(r["phi"], 6), r)
+        mine = [one[phi] for phi in sorted(one)]
+        phi, pressure, error, _ = reference(n, box)
         published = loop_extrema(phi, pressure, error)
         if published is None:
             continue
         ours = np.array([[r[k] for k in ("phi", "bPd2", "err")] for r in mine]).T
         same = np.isin(np.round(phi, 3), np.round(ours[0], 3))
-        found[name] = {"published": published,
-                       "published_at_our_phi": loop_extrema(*(x[same] for x in
-                                                              (phi, pressure, error))),
-                       "sim": loop_extrema(*ours)}
+        found[f"N = {n}, box {box}"] = {
+            "published": published,
+            "published_at_our_phi": loop_extrema(*(x[same] for x in (phi, pressure, error))),
+            "sim": loop_extrema(*ours)}
     return found
+
+
+#: the starts, in the order in which one run per φ is taken for the loop's extrema
+STARTS = ("compressed", "lattice", "melted")
 
 
 def processor_hours(records):
@@ -116,7 +125,7 @@ def write_markdown(records, found, results):
                   "errors: half the 16–84 % range over resamplings of the points within "
                   "their errors). The published ones from all their points, and from those "
                   "at the φ of the runs, which compare with ours.", "",
-                  "| N, box | | maximum: φ, βP d² | minimum: φ, βP d² |",
+                  "| N and box | | maximum: φ, βP d² | minimum: φ, βP d² |",
                   "| --- | --- | --- | --- |"]
         for name, all_three in found.items():
             for label, key in (("published, all points", "published"),
