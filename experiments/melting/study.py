@@ -7,14 +7,15 @@ under ``--out`` (``runs/<group>-<φ>/run.h5``), which also keeps the point's ana
 (``point.json``) and the processor seconds it took (``cpu_seconds``). A point is run in
 rounds: the first runs ``first`` collisions per disk; after each,
 :func:`sim.analysis.equation_of_state.run_pressure` drops the equilibration blocks by the
-MSER rule and finds the blocking error of the rest, and the point is done when that error is
-at most the group's ``target``, the blocking has converged, the means of the production's two
-halves agree within ``DRIFT`` standard errors and ``PRODUCTION_BLOCKS`` blocks are
-kept. Otherwise it is resumed to the length its error asks for (:func:`next_length`), at most
-``longest`` collisions per disk; a point that reaches it stays as it is, its error in the
-tables. The runs go to a pool of ``--jobs`` worker processes, the longest first, each point
-given its next run as soon as one ends; or with ``--cluster slurm``, in rounds of jobs, to
-SLURM through submitit.
+MSER rule and finds the blocking error of the rest, and the point is done when that error
+is at most the group's ``target``, the blocking has converged, the means of the
+production's two halves agree within ``DRIFT`` standard errors, ``PRODUCTION_BLOCKS``
+blocks are kept and the cut is at most a share ``CUT`` of the blocks. Otherwise it is
+resumed to the length its error asks for (:func:`next_length`), at most ``longest``
+collisions per disk; a point that reaches it stays as it is, its error in the tables. The
+runs go to a pool of ``--jobs`` worker processes, the longest first, each point given its
+next run as soon as one ends; or with ``--cluster slurm``, in rounds of jobs, to SLURM
+through submitit.
 
 Interrupted (Ctrl-C, a killed job, the end of a session), the study starts again where it
 was: a run resumes from its last checkpoint (written every 30 s of wall time and at every
@@ -50,6 +51,7 @@ import numpy as np
 from figures import TRACED, draw_bond_order, draw_equation_of_state, draw_starts, trace
 from plan import (
     AGREEMENT,
+    CUT,
     DRIFT,
     GROWTH,
     MARGIN,
@@ -82,9 +84,10 @@ def _record(point):
 
 def reached(point, record):
     """Whether the point's run meets its group's target: error, convergence, no drift and
-    ``PRODUCTION_BLOCKS`` blocks kept."""
+    ``PRODUCTION_BLOCKS`` blocks kept, at most a share ``CUT`` of the blocks cut."""
     return (record["err"] <= point.group.target and record["converged"]
-            and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS)
+            and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS
+            and record["cut"] <= CUT * (record["cut"] + record["blocks"]))
 
 
 def agrees(record, others):
@@ -359,7 +362,8 @@ def summarise(todo, out, results):
     summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
                "rules": {"drift": DRIFT, "margin": MARGIN, "growth": GROWTH,
-                         "production_blocks": PRODUCTION_BLOCKS, "agreement": AGREEMENT}}
+                         "production_blocks": PRODUCTION_BLOCKS, "cut": CUT,
+                         "agreement": AGREEMENT}}
     with whole_file(results / "melting.json") as partial:
         partial.write_text(json.dumps(summary, indent=1, default=float))
     print(f"melting: {len(records)} points, {sum(hours.values()):.2f} processor hours, "

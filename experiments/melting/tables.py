@@ -6,7 +6,7 @@ import csv
 import math
 
 import numpy as np
-from plan import AGREEMENT, DRIFT, GROWTH, MARGIN, PLAN, PRODUCTION_BLOCKS
+from plan import AGREEMENT, CUT, DRIFT, GROWTH, MARGIN, PLAN, PRODUCTION_BLOCKS
 
 from sim.checks.melting import loop_extrema, reference
 from sim.storage.whole_file import whole_file
@@ -92,7 +92,9 @@ def write_markdown(records, found, results):
     lines = [f"A point is done when the blocking error of βP d² over its production is at "
              f"most its group's target, the blocking has converged, the means of the "
              f"production's halves differ by less than {DRIFT:g} standard errors, at "
-             f"least {PRODUCTION_BLOCKS} blocks are kept and its βP d² agrees with that of "
+             f"least {PRODUCTION_BLOCKS} blocks are kept, at most {CUT:.0%} of the blocks "
+             f"are cut as equilibration (a longer cut is a transient the run is too short "
+             f"for, or rare excursions taken for one) and its βP d² agrees with that of "
              f"the runs of the same state point from other starts within {AGREEMENT:g} "
              f"combined standard errors; else it runs on to {MARGIN:g} times "
              f"the length its error asks for ({GROWTH[0]:g} to {GROWTH[1]:g} times its "
