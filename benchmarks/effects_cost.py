@@ -51,6 +51,8 @@ EFFECTS = {
     "growth": ({}, {}, {"growth_rate": 0.0}, {"growth_rate": 0.01}),
     "friction": ({"tangential_restitution": 0.5}, {}, {"friction": math.inf},
                  {"friction": 0.3}),
+    "square_well": ({}, {}, {"potential_steps": []},
+                    {"potential_steps": [1.5], "potential_energies": [-1.0]}),
 }
 
 

@@ -35,7 +35,8 @@ EVERY_EFFECT_ON = ("restitution.disk=0.9", "restitution.wall=0.9", "tc.time=1e-6
                    "observe.event_log=true",
                    "restitution.tangential=0.5", "restitution.wall_tangential=0.5",
                    "friction.mu=0.3", "friction.wall_mu=0.3", "disks.inertia_factor=0.4",
-                   "disks.rotational_temperature=1")
+                   "disks.rotational_temperature=1", "potential.steps=[1.5]",
+                   "potential.energies=[-1]")
 
 #: sections of conf/config.yaml that the pipeline owns and effects may read too
 PIPELINE_SECTIONS = {"seed", "box", "observe", "disks"}
@@ -136,6 +137,7 @@ def test_loop_values_fill_exactly_the_effects_fields():
         values = effect.module.loop_values(keywords, context)
         # and an effect's system event (sim.effects docstring), none with these defaults
         assert values.pop("system_event", None) is None, effect.name
+        assert values.pop("pair_interaction", None) is None, effect.name
         assert tuple(values) == effect.fields, effect.name
         context.update(values)
 

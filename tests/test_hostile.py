@@ -353,6 +353,18 @@ BAD_INPUT = {
                                      "walls.bottom.frequency=10", "growth.rate"),
     "growth-of-rough-disks": ("growth.rate=0.1 restitution.tangential=0.5", "growth.rate"),
     "compress-without-growth": ("scenario=compress growth.rate=0", "growth.rate"),
+    # stepped potentials
+    "step-inside-the-core": ("potential.steps=[0.9] potential.energies=[-1]",
+                             "potential.steps"),
+    "steps-not-increasing": ("potential.steps=[1.5,1.2] potential.energies=[-1,1]",
+                             "potential.steps"),
+    "step-energy-nan": ("potential.steps=[1.5] potential.energies=[nan]", "potential.energies"),
+    "step-energy-inf": ("potential.steps=[1.5] potential.energies=[-inf]",
+                        "potential.energies"),
+    "step-without-its-energy": ("potential.steps=[1.5,2] potential.energies=[-1]",
+                                "potential.energies"),
+    "steps-of-growing-disks": ("scenario=compress potential.steps=[1.5] "
+                               "potential.energies=[-1]", "potential.steps"),
     "compress-ratio-below-1": ("scenario=compress compress.radius_ratio=0.5",
                                "compress.radius_ratio"),
     "jamming-pressure-1": ("stop.jamming=1", "stop.jamming"),
@@ -488,6 +500,11 @@ NEVER = {
     "rdf-r_max-beyond-half-box": ("observe.radial_distribution.bins=50 "
                                   "observe.radial_distribution.r_max=100",
                                   "observe.radial_distribution.r_max"),
+    "step-beyond-half-the-box": ("scenario=square_well box.boundary=periodic "
+                                 "walls.left.temperature=null walls.right.temperature=null "
+                                 "walls.bottom.temperature=null walls.top.temperature=null "
+                                 "potential.steps=[60]",
+                                 "potential.steps"),
     # a time reached only after more collisions than the engine counts (ran on for ever)
     "time-beyond-2^62-collisions": ("disks.n=100 stop.collisions=null stop.time=1e50",
                                     "stop.time"),

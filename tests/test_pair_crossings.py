@@ -9,7 +9,6 @@ say whether its disks are closer than λ σ_ij.
 One kind, so one compiled variant of the loop, outside the quick suite's canonical set: slow.
 """
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -23,6 +22,7 @@ from sim.engine.kinematics import (
     RADIUS,
     may_touch_before,
     pair_contact_time,
+    pair_exit_time,
 )
 from sim.engine.pairs import collide, pair_state, rules, set_pair_state
 
@@ -39,30 +39,16 @@ class Crossings(NamedTuple):
 
 
 @njit
-def exit_time(rx, ry, vx, vy, distance):
-    """When a pair inside ``distance`` (its state says so, whatever round-off says of r) is
-    at that distance again, moving out: the larger root of |r + v τ|² = distance², 0 for a
-    pair already beyond it and receding."""
-    a = vx * vx + vy * vy
-    if a == 0.0:
-        return INF
-    b = rx * vx + ry * vy
-    c = rx * rx + ry * ry - distance * distance
-    s = math.sqrt(max(b * b - a * c, 0.0))
-    if b <= 0.0:
-        return (s - b) / a
-    return max(-c / (b + s), 0.0)
-
-
-@njit
 def crossing_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     if state == OUTSIDE:
         if may_touch_before(rx, ry, vx, vy, value.ratio * sigma, tau):
             return pair_contact_time(rx, ry, vx, vy, value.ratio * sigma), INWARD
         return INF, INWARD
     if may_touch_before(rx, ry, vx, vy, sigma, tau):
-        return pair_contact_time(rx, ry, vx, vy, sigma), CORE
-    return exit_time(rx, ry, vx, vy, value.ratio * sigma), OUTWARD  # no contact first
+        contact = pair_contact_time(rx, ry, vx, vy, sigma)
+        if contact < INF:  # the filter passes pairs that miss, too
+            return contact, CORE
+    return pair_exit_time(rx, ry, vx, vy, value.ratio * sigma), OUTWARD  # no contact first
 
 
 @njit

@@ -32,6 +32,8 @@ settling_bed      ``restitution``, ``wall_restitution``, ``tc`` and ``gravity``,
 rough_cooling     ``restitution``, ``tangential_restitution`` (rough, no friction) and ``tc``
 observers         ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk alike
 compress          ``growth`` (and its system event, the rescaling); radii and species per disk
+square_well       a stepped pair potential (``potential_steps``), every disk alike; its
+                  shoulder twin too
 gas_lookahead     gas, looking ahead
 crater_lookahead  crater, looking ahead
 ================  ==============================================================================
@@ -51,6 +53,7 @@ SCENARIOS = sorted(p.stem for p in Path(CONF_DIR, "scenario").glob("*.yaml"))
 
 #: overrides that make a scene small enough for a quick test (same compiled variant)
 SHRINK = {"gas": ["disks.n=300"], "mixture": ["disks.n=300"], "cooling": ["disks.n=300"],
+          "square_well": ["disks.n=300"], "square_shoulder": ["disks.n=300"],
           "compress": ["disks.n=300"],
           "driven": ["disks.n=300"], "vibrated_bed": ["bed.n=100"],
           "crater": ["bed.n=400", "projectile.radius=0.02"],
@@ -78,7 +81,7 @@ SLOW_SCENARIOS = ("crater_gravity",)
 #: recorder on
 CANONICAL = {**{scene: (scene,) for scene in ("gas", "mixture", "cooling", "driven",
                                                "vibrated_bed", "crater", "rough_cooling",
-                                               "compress")},
+                                               "compress", "square_well")},
              "settling_bed": ("gas", "gravity=[0,-1]", "restitution.disk=0.9",
                               "restitution.wall=0.9", "tc.time=1e-4"),
              "observers": ("gas", *OBSERVERS),
@@ -119,13 +122,14 @@ def describe(signature):
 
     disks, neighbours, effects = (named(signature[k]) for k in (0, 2, 4))
     ahead = "" if signature[7] == types.none else "; looking ahead"
+    pair = "" if signature[5] == types.none else f"; pair interaction {signature[5]}"
     per_disk = [name for name in ("delta", "mass", "species")
                 if isinstance(disks[name], types.Array)]
     if isinstance(neighbours["nb_cap"], types.Array):
         per_disk.append("list capacity")
     on = [name for name, kind in effects.items() if kind != types.none and name != "seed"]
     return (f"effects: {', '.join(on) or 'none'}; per disk: {', '.join(per_disk) or 'none'}"
-            f"{ahead}; types: {signature}")
+            f"{ahead}{pair}; types: {signature}")
 
 
 def warm(names):

@@ -20,9 +20,18 @@ The protocol: every effect module defines
 ``loop_values(keywords, context)``
     its fields of :class:`Effects`, {field: value, None when off or neutral}, from every
     effect's keywords and the ``context``: the scene (n, n_species, box, periodic, radius,
-    mass, initial_energy) and the fields of the effects before it in :data:`EFFECTS`; and,
-    for an effect that acts on the whole system at times (growth's rescaling), the key
-    ``system_event``: its system event (:mod:`sim.engine.system`), or None.
+    mass, initial_energy) and the fields of the effects before it in :data:`EFFECTS`; for
+    an effect that acts on the whole system at times (growth's rescaling), the key
+    ``system_event``: its system event (:mod:`sim.engine.system`), or None; and for an
+    effect that is the pairs' interaction (a stepped potential), the key
+    ``pair_interaction``: its value (:mod:`sim.engine.pairs`), or None.
+
+and may define
+
+``check_scene(cfg, scene)``
+    raise :class:`sim.effects.values.ConfigError` for a value of its config keys that the
+    scene built from the config cannot take (:class:`sim.pipeline.scenes.Scene`: radii,
+    species, box), before the engine is made.
 
 The functions below run the protocol over every effect, in the order of :data:`EFFECTS`.
 """
@@ -79,6 +88,9 @@ EFFECTS = (
                    for key in ("temperature", "speed", "amplitude")),
            ("compression_eos", "jamming_density",
             "test_growth.py::test_growing_gas_never_overlaps"), ("growth",)),
+    Effect("potential", (), ("potential.steps", "potential.energies", "growth.rate"),
+           ("test_potential.py::test_a_square_well_gas_keeps_its_energy_and_its_pair_states",),
+           ("square_well",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
            ("test_observers.py::test_unwrapped_positions_agree_with_unwrapping_frequent_snapshots",),
            ("unwrap",)),
@@ -98,7 +110,8 @@ EFFECTS = (
 #: :class:`sim.effects.rotation.Friction`, spin float64[n], growth
 #: :class:`sim.effects.growth.Growth`. An effect's ``loop_values`` may also return the key
 #: ``system_event``: the system event (:mod:`sim.engine.system`) the effect needs, which the
-#: engine runs (growth's rescaling).
+#: engine runs (growth's rescaling), and the key ``pair_interaction``: the pairs' interaction
+#: the effect is (:mod:`sim.effects.potential`), which the loop takes as its own argument.
 Effects = namedtuple("Effects", [field for effect in EFFECTS for field in effect.fields])
 
 
@@ -119,6 +132,15 @@ def check_config(cfg):
     """Every effect's check of its config keys (:class:`ConfigError` on the first bad one)."""
     for effect in EFFECTS:
         effect.module.check_config(cfg)
+
+
+def check_scene(cfg, scene):
+    """Every effect's check of its config keys against the scene built from the config (those
+    effects that have one)."""
+    for effect in EFFECTS:
+        check = getattr(effect.module, "check_scene", None)
+        if check is not None:
+            check(cfg, scene)
 
 
 def engine_arguments(cfg):

@@ -124,6 +124,7 @@ class Engine(Running, Observables, Checkpoints):
             "radius": radius, "mass": mass, "initial_energy": self.initial_energy})
         disk_effects = {field: values.pop(field) for field in OPTIONAL_PER_DISK}
         effect_system = values.pop("system_event")
+        effect_pair = values.pop("pair_interaction")
         for field, value in values.items():
             setattr(self, field, value)
         # the far edge of the disks, whose ulps bound those of their coordinates (a disk
@@ -151,6 +152,11 @@ class Engine(Running, Observables, Checkpoints):
                 raise refused("Engine", "system_event", system_event, "None for growing disks, "
                               "whose rescaling of the velocities is the system event")
             system_event = effect_system
+        if effect_pair is not None:
+            if pair_interaction is not None:
+                raise refused("Engine", "pair_interaction", pair_interaction, "None with a "
+                              "stepped potential, which is the pair interaction")
+            pair_interaction = effect_pair
         if self.growth is not None and pair_interaction is not None:
             raise refused("Engine", "pair_interaction", pair_interaction,
                           "None for growing disks: they grow hard cores")

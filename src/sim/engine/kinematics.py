@@ -94,6 +94,24 @@ def pair_contact_time(rx, ry, vx, vy, sigma):
 
 
 @njit(cache=True, inline="always")
+def pair_exit_time(rx, ry, vx, vy, distance):
+    """Time until two disks that are closer than ``distance`` (their pair's state says so,
+    whatever round-off says of |r|) are at that distance again, moving apart: the larger root
+    of |r + v τ|² = distance² (b = r·v, c = |r|² − distance², a = |v|²), (s − b)/a for b ≤ 0
+    and −c/(b + s) for b > 0 with s = √(b² − a c) (no cancellation); at once (0) for a pair
+    found beyond it by round-off and moving apart; ∞ for a pair at rest."""
+    a = vx * vx + vy * vy
+    if a == 0.0:
+        return INF
+    b = rx * vx + ry * vy
+    c = rx * rx + ry * ry - distance * distance
+    s = math.sqrt(max(b * b - a * c, 0.0))
+    if b <= 0.0:
+        return (s - b) / a
+    return max(-c / (b + s), 0.0)
+
+
+@njit(cache=True, inline="always")
 def may_touch_before(rx, ry, vx, vy, sigma, tau):
     """Whether two disks (separation ``r``, relative velocity ``v``, contact distance σ) may
     touch sooner than τ; when not, :func:`pair_contact_time` is at least τ.

@@ -12,6 +12,7 @@ from sim.effects.rotation import moment_of_inertia, rotational_energy
 from sim.effects.walls import wall_state
 from sim.engine import codes, loop
 from sim.engine.kinematics import T_OWN, VX, VY, X, Y
+from sim.engine.pairs import pair_energy
 from sim.engine.stamps import count_all_contacts
 
 
@@ -163,8 +164,11 @@ class Observables:
         return rotational_energy(self.angular_velocities(), self.moments_of_inertia())
 
     def potential_energy(self, t=None):
-        """Σ −m g·r at time t (zero without gravity)."""
-        return potential_energy(self._state(t)[0], self.disks.mass, self.gravity)
+        """Σ −m g·r at time t (zero without gravity), plus the potential energy of the
+        pairs from their states (:func:`sim.engine.pairs.pair_energy`; zero for hard
+        disks)."""
+        return (potential_energy(self._state(t)[0], self.disks.mass, self.gravity)
+                + pair_energy(self.pair_interaction, self.disks))
 
     @property
     def wall_work(self):

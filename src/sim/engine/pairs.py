@@ -43,6 +43,9 @@ may call :func:`pair_state` and :func:`set_pair_state`)
     neighbour lists later was farther apart than its reach and starts at state 0. The state is
     kept beside the pair's two entries of the lists (``Neighbours.pair_state``), through
     rebuilds, renumbering and checkpoints.
+``energy`` (optional, Python; for a kind with a potential energy)
+    ``energy(value, disks)``: the potential energy of every pair from their states (a
+    float), which :meth:`sim.engine.Engine.potential_energy` adds to that of gravity.
 
 A kind without its own ``apply`` keeps no event of its own: its ``event`` is taken as a
 contact. A scene pays for what its kind has and nothing else: the event names, the reach
@@ -84,15 +87,16 @@ class Rules(NamedTuple):
     apply: object = None
     reach: object = None
     initial_state: object = None
+    energy: object = None
 
 
 #: the rules of each kind of pair interaction: NamedTuple class → :class:`Rules`
 RULES = {}
 
 
-def rules(kind, event_time, apply=None, *, reach=None, initial_state=None):
+def rules(kind, event_time, apply=None, *, reach=None, initial_state=None, energy=None):
     """Register the compiled rules of the pair interaction ``kind`` (a NamedTuple class)."""
-    RULES[kind] = Rules(event_time, apply, reach, initial_state)
+    RULES[kind] = Rules(event_time, apply, reach, initial_state, energy)
 
 
 def _rules_of(value):
@@ -120,8 +124,14 @@ def _own_apply(pair):
 
 def keeps(pair, rule):
     """Whether the kind of ``pair`` (None: hard disks) has the optional rule ``rule``
-    (``"apply"``, ``"reach"``, ``"initial_state"``): the engine then allocates its arrays."""
+    (``"apply"``, ``"reach"``, ``"initial_state"``, ``"energy"``): the engine then
+    allocates its arrays."""
     return pair is not None and getattr(RULES[type(pair)], rule) is not None
+
+
+def pair_energy(pair, disks):
+    """The potential energy of the pairs (the kind's ``energy`` rule), 0 without one."""
+    return float(RULES[type(pair)].energy(pair, disks)) if keeps(pair, "energy") else 0.0
 
 
 @njit(cache=True, inline="always")

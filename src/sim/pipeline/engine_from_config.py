@@ -1,7 +1,7 @@
 """The engine of a validated config: its scene, and the keywords of every effect
 (:func:`sim.effects.engine_arguments`)."""
 
-from sim.effects import engine_arguments
+from sim.effects import check_scene, engine_arguments
 from sim.engine.core import Engine
 from sim.pipeline.config import ConfigError
 from sim.pipeline.scenes import build_scene
@@ -10,6 +10,7 @@ from sim.pipeline.scenes import build_scene
 def build_engine(cfg):
     """Scene and engine for a validated config; bad values raise :class:`ConfigError`."""
     scene = build_scene(cfg)
+    check_scene(cfg, scene)
     try:
         return Engine(scene.position, scene.velocity, scene.radius, scene.mass, scene.species,
                       boundary=scene.boundary, **engine_arguments(cfg))

@@ -496,6 +496,9 @@ SCENES = {spec.name: spec for spec in (
     SceneSpec("cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("driven", gas, given_count, preparation=_gas_preparation, gas_like=True),
     SceneSpec("rough_cooling", gas, given_count, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("square_well", gas, given_count, preparation=_gas_preparation, gas_like=True),
+    SceneSpec("square_shoulder", gas, given_count, preparation=_gas_preparation,
+              gas_like=True),
     SceneSpec("vibrated_bed", vibrated_bed, _bed_count, preparation=_bed_preparation,
               sections=("bed",), check=_check_vibrated_bed, packing_fraction=_bed_packing),
 )}

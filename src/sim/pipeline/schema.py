@@ -78,6 +78,12 @@ class GrowthConfig:
 
 
 @dataclass
+class PotentialConfig:
+    steps: list = field(default_factory=list)
+    energies: list = field(default_factory=list)
+
+
+@dataclass
 class StopConfig:
     collisions: Optional[int] = None
     contacts: Optional[int] = None
@@ -180,6 +186,7 @@ class SimConfig:
     gravity: list = field(default_factory=lambda: [0.0, 0.0])
     walls: WallsConfig = field(default_factory=WallsConfig)
     growth: GrowthConfig = field(default_factory=GrowthConfig)
+    potential: PotentialConfig = field(default_factory=PotentialConfig)
     stop: StopConfig = field(default_factory=StopConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
     observe: ObserveConfig = field(default_factory=ObserveConfig)

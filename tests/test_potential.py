@@ -1,0 +1,131 @@
+"""Stepped pair potentials (sim.effects.potential): square wells and shoulders around the hard
+core. Every test here runs the quick suite's one compiled variant of them (the square_well
+scene's: a stepped potential and thermal walls, every disk alike; a pair of disks gets a
+thermal wall it never reaches)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from conftest import assert_no_overlap, distances
+from sim.engine import Boundary, Engine
+from sim.pipeline.runner import build_engine
+from variants import UNREACHED_THERMAL_WALL, compose_scene
+
+
+def _shells_by_distance(engine, steps, slack):
+    """The shell of every pair (i < j, the user's numbering) by its distance over σ: the
+    pairs surely in each shell (1 … K; 0 beyond) and those maybe in it, within ``slack``."""
+    distance = distances(engine) / (2.0 * engine.radius[0])
+    upper = np.triu(np.ones(distance.shape, bool), 1)
+    edges = np.array([1.0, *steps, np.inf])
+    surely, maybe = {}, {}
+    for k in range(1, len(edges)):
+        shell = k if k < len(edges) - 1 else 0
+        surely[shell] = {tuple(p) for p in np.argwhere(
+            upper & (distance > edges[k - 1] * (1 + slack)) & (distance < edges[k] * (1 - slack)))}
+        maybe[shell] = {tuple(p) for p in np.argwhere(
+            upper & (distance > edges[k - 1] * (1 - slack)) & (distance < edges[k] * (1 + slack)))}
+    return surely, maybe
+
+
+def _shells_by_state(engine):
+    """{shell: pairs (i < j)} of the listed pairs, from their states (shell 0 not listed)."""
+    d = engine.disks
+    shells = {}
+    for i in range(engine.n):
+        for k in range(d.nb_start[i], d.nb_start[i] + d.nb_count[i]):
+            a, b = int(d.order[i]), int(d.order[d.nb[k]])
+            shells.setdefault(int(d.pair_state[k]), set()).add((min(a, b), max(a, b)))
+    return shells
+
+
+def test_a_square_well_gas_keeps_its_energy_and_its_pair_states():
+    """The square_well scene (N = 300): kinetic plus potential energy less the work of the
+    thermal walls constant to round-off, no overlap, and every pair's state the shell its
+    distance puts it in, through many crossings of the well's edge, bounces off it and core
+    contacts; and the gas condenses."""
+    engine = build_engine(compose_scene("square_well"))
+    steps = [1.5]
+    total = engine.kinetic_energy() + engine.potential_energy()
+    start = engine.potential_energy()
+    assert start < 0.0
+    for end in np.linspace(0.5, 5.0, 6):
+        engine.run(time=end)
+        assert_no_overlap(engine)
+        assert engine.kinetic_energy() + engine.potential_energy() - engine.wall_work \
+            == pytest.approx(total, rel=1e-12, abs=1e-12 * engine.kinetic_energy())
+        surely, maybe = _shells_by_distance(engine, steps, 1e-9)
+        by_state = _shells_by_state(engine)
+        assert surely[1] <= by_state.get(1, set()) <= maybe[1]
+    assert engine.collisions > 20 * engine.n
+    assert engine.events > engine.collisions + engine.n  # crossings and bounces as well
+    assert engine.potential_energy() < start - 0.5 * engine.n  # half a well per disk more
+
+
+def test_pair_states_and_energy_resume_to_the_same_bits():
+    engine = build_engine(compose_scene("square_well"))
+    engine.run(time=1.0)
+    state = {key: np.array(value) for key, value in engine.state_dict().items()}
+    engine.run(time=2.0)
+    resumed = build_engine(compose_scene("square_well"))
+    resumed.load_state_dict(state)
+    resumed.run(time=2.0)
+    assert resumed.positions().tobytes() == engine.positions().tobytes()
+    assert resumed.disks.pair_state.tobytes() == engine.disks.pair_state.tobytes()
+    assert resumed.potential_energy() == engine.potential_energy()
+
+
+def _pair(separation, speed, energy, steps=(1.5,)):
+    """Two disks of radius 0.01 and mass 1 on the x axis ``separation`` σ apart, each moving
+    at ``speed``/2 towards the other (a negative ``speed``: apart), in a box with walls far
+    away (a thermal one they never reach), with a potential of ``energy`` out to
+    ``steps``."""
+    sigma = 0.02
+    x = 0.5 - 0.5 * separation * sigma, 0.5 + 0.5 * separation * sigma
+    return Engine([[x[0], 0.5], [x[1], 0.5]], [[speed / 2, 0.0], [-speed / 2, 0.0]], 0.01,
+                  boundary=Boundary(size=(1.0, 1.0)), potential_steps=list(steps),
+                  potential_energies=[energy] * len(steps), walls=UNREACHED_THERMAL_WALL), sigma
+
+
+def _relative_speed(engine, t):
+    v = engine.velocities(t)
+    return abs(v[0, 0] - v[1, 0])
+
+
+@pytest.mark.parametrize("speed, energy, crosses", [(1.0, -1.0, True), (1.0, 1.0, False),
+                                                    (3.0, 1.0, True), (2.0, 1.0, False)])
+def test_a_pair_crosses_a_step_only_with_the_normal_kinetic_energy_to_pay_for_it(
+        speed, energy, crosses):
+    """Head on, with μ = 1/2: the pair crosses the step at 1.5 σ when μ v²/2 = v²/4 > ε, its
+    relative speed then √(v² − 4 ε), and bounces off it otherwise; after the core contact
+    it leaves at its first speed. Kinetic plus potential energy stays v²/4."""
+    engine, sigma = _pair(2.0, speed, energy)
+    flight = 0.5 * sigma / speed  # to the step, from 2 σ apart
+    engine.run(time=1.01 * flight)
+    inside = crosses and engine.potential_energy() == energy
+    assert inside == crosses
+    expected = math.sqrt(speed**2 - 4.0 * energy) if crosses else speed
+    assert _relative_speed(engine, 1.01 * flight) == pytest.approx(expected, rel=1e-12)
+    assert engine.kinetic_energy() + engine.potential_energy() == pytest.approx(
+        speed**2 / 4, rel=1e-12)
+    engine.run(time=0.3 / speed)  # apart again, before the walls
+    assert _relative_speed(engine, 0.3 / speed) == pytest.approx(speed, rel=1e-12)
+    assert engine.potential_energy() == 0.0
+    assert engine.collisions == (1 if crosses else 0)
+
+
+def test_a_pair_without_the_energy_to_leave_its_well_stays_bound():
+    """Two disks 1.2 σ apart inside a well of depth 1, moving apart at relative speed 1
+    (v²/4 < 1): they bounce off the well's edge and off each other's core for ever, at the
+    same speed, never farther than 1.5 σ."""
+    engine, sigma = _pair(1.2, -1.0, -1.0)
+    for end in np.linspace(0.05, 1.0, 20):
+        engine.run(time=end)
+        gap = np.diff(engine.positions(end)[:, 0])[0]
+        assert sigma <= gap <= 1.5 * sigma * (1 + 1e-12)
+        assert _relative_speed(engine, end) == pytest.approx(1.0, rel=1e-12)
+    assert engine.potential_energy() == -1.0
+    assert engine.collisions > 10
+
