@@ -3,15 +3,18 @@
 Elastic disks in a periodic unit box, started from a lattice (or random placement when
 dilute) and equilibrated for ``--warmup`` collisions per disk before timing; one thread.
 Columns: collisions_per_s and events_per_s (every event the engine applies: disk and wall
-contacts and neighbour-shell exits) over all timed collisions, best_chunk_collisions_per_s
+contacts, neighbour-shell exits and a pair interaction's other events) over all timed
+collisions, pair_events_per_s (the events of pairs: collisions, and a step's crossings and
+bounces), best_chunk_collisions_per_s
 (the fastest of ``--chunks`` equal parts: on a shared machine, the rate least disturbed),
 bytes_per_disk (engine arrays) and rss_bytes_per_disk (peak resident-set growth),
 compile_s (first engine built and run in this process: compilation or cache load), and
 reference_ratio (this engine over the textbook reference engine, same N and φ, same process,
 N ≤ 10⁴). Extra rows compare effects: ξ < 1 with TC; growing disks (reference_ratio: their
 rate over that of the same gas not growing) and the compress scene of 10⁴ disks run to
-jamming (its wall time in the scene's name); and the crater bed with and without its
-projectile.
+jamming (its wall time in the scene's name); a square well (λ = 1.5, ε = 1) at N = 10⁴,
+φ = 0.3 beside hard disks of the same state (reference_ratio: its pair events per second
+over their collisions per second); and the crater bed with and without its projectile.
 
     python benchmarks/engine_rate.py                       # the full table
     python benchmarks/engine_rate.py --n 10000 --phi 0.5 --json
@@ -28,6 +31,7 @@ import numpy as np
 
 from sim.checks.reference import ReferenceEngine
 from sim.engine import Boundary, Engine
+from sim.engine.codes import SHELL_EXITS
 from sim.pipeline.initial import (
     fixed_speed,
     hexagonal_lattice,
@@ -57,10 +61,13 @@ def peak_rss_bytes():
 
 
 def timed_rate(engine, collisions, chunks):
-    """Collisions and events per second over ``collisions`` collisions, timed in ``chunks``
-    equal parts; also the rate of the fastest part, the engine's speed while the machine
-    disturbed it least (timeit's minimum time)."""
+    """Collisions, events and pair events (collisions and a pair interaction's other events,
+    such as a step's crossings: the events but shell exits and wall contacts) per second
+    over ``collisions`` collisions, timed in ``chunks`` equal parts; also the rate of the
+    fastest part, the engine's speed while the machine disturbed it least (timeit's minimum
+    time)."""
     c0, e0 = engine.collisions, engine.events
+    others0 = engine.counters[SHELL_EXITS] + engine.wall_contacts
     chunk_rates = []
     seconds = 0.0
     for k in range(1, chunks + 1):
@@ -70,8 +77,9 @@ def timed_rate(engine, collisions, chunks):
         elapsed = time.perf_counter() - started
         seconds += elapsed
         chunk_rates.append((engine.collisions - c_start) / elapsed)
+    others = engine.counters[SHELL_EXITS] + engine.wall_contacts - others0
     return ((engine.collisions - c0) / seconds, (engine.events - e0) / seconds,
-            max(chunk_rates))
+            (engine.events - e0 - others) / seconds, max(chunk_rates))
 
 
 def build(*args, **kwargs):
@@ -101,12 +109,12 @@ def gas_row(n, phi, collisions, warmup, reference_events, chunks, **effects):
                    **effects)
     compile_s = FIRST_CALL["seconds"]
     engine.run(collisions=engine.collisions + int(warmup * n))
-    coll_rate, event_rate, best_chunk_rate = timed_rate(engine, collisions, chunks)
+    coll_rate, event_rate, pair_rate, best_chunk_rate = timed_rate(engine, collisions, chunks)
     row = {"scene": "gas" if not effects else "gas " + " ".join(
                f"{k}={v}" for k, v in effects.items()),
            "n": n, "phi": phi, "collisions_per_s": round(coll_rate),
            "best_chunk_collisions_per_s": round(best_chunk_rate),
-           "events_per_s": round(event_rate),
+           "events_per_s": round(event_rate), "pair_events_per_s": round(pair_rate),
            "bytes_per_disk": round(engine_bytes(engine) / n, 1),
            "rss_bytes_per_disk": round(max(peak_rss_bytes() - rss_before, 0) / n, 1),
            "compile_s": round(compile_s, 2), "reference_ratio": None}
@@ -212,6 +220,16 @@ def main(argv=None):
                                                 / off["collisions_per_s"], 3)
         emit(rows[-1], args.json)
         rows.append(compress_row(n))
+        emit(rows[-1], args.json)
+        # a square well (λ = 1.5, ε = 1 at T = 1) against hard disks of the same state: its
+        # collisions and step crossings and bounces per second over their collisions per second
+        hard = gas_row(n, 0.3, max(args.collisions, 20 * n), args.warmup, 0, args.chunks)
+        rows.append(hard)
+        emit(rows[-1], args.json)
+        rows.append(gas_row(n, 0.3, max(args.collisions, 20 * n), args.warmup, 0, args.chunks,
+                            potential_steps=[1.5], potential_energies=[-1.0]))
+        rows[-1]["reference_ratio"] = round(rows[-1]["pair_events_per_s"]
+                                            / hard["collisions_per_s"], 3)
         emit(rows[-1], args.json)
         for row in crater_rows(min(args.collisions, 2_000_000)):
             rows.append(row)

@@ -172,7 +172,7 @@ def stepped_potential(steps, energies):
     return SteppedPotential(table, values, count, reach)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     """The next event of the pair (i, j) in shell ``state`` (see the module docstring): the
     inner edge reached moving in, if the pair reaches it (and may before τ, the filter), else
@@ -195,13 +195,13 @@ def step_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     return pair_exit_time(rx, ry, vx, vy, value.steps[a, b, state - 1] * sigma), OUTWARD
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def shell_energy(value, a, b, state):
     """u of species pair (a, b) in shell ``state`` (0: beyond the last step)."""
     return 0.0 if state == 0 else value.energies[a, b, state - 1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def cross_step(value, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
                contact):
     """Apply the pair event ``event`` of disks i and j, both flown to time t: the core
@@ -243,7 +243,7 @@ def cross_step(value, event, i, j, t, t_origin, disks, neighbours, box, effects,
     return 0.0, dp * r, False, -1, False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_reach(value, i, disks):
     """λ_max R_i: disks i and j have no event while farther apart than λ_max (R_i + R_j)."""
     return value.reach[per_disk(disks.species, i)] * disks.table[i, RADIUS]
