@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_no_overlap, distances
+from sim.checks.potential import second_virial_coefficient
 from sim.engine import Boundary, Engine
 from sim.pipeline.runner import build_engine
 from variants import UNREACHED_THERMAL_WALL, compose_scene
@@ -129,3 +130,14 @@ def test_a_pair_without_the_energy_to_leave_its_well_stays_bound():
     assert engine.potential_energy() == -1.0
     assert engine.collisions > 10
 
+
+
+def test_the_second_virial_coefficient_is_the_hard_cores_and_vanishes_at_boyles_temperature():
+    """B₂/σ² = π/2 without steps or with zero energies; for a well of width λ it vanishes at
+    kT_B/ε = 1/ln(λ²/(λ² − 1)), and a shoulder as high as the core is wide (ε → ∞) gives
+    the hard disks of diameter λσ."""
+    assert second_virial_coefficient(1.0, [], []) == pytest.approx(math.pi / 2)
+    assert second_virial_coefficient(1.0, [1.5], [0.0]) == pytest.approx(math.pi / 2)
+    boyle = 1.0 / math.log(1.5**2 / (1.5**2 - 1.0))
+    assert second_virial_coefficient(boyle, [1.5], [-1.0]) == pytest.approx(0.0, abs=1e-12)
+    assert second_virial_coefficient(1.0, [1.5], [1e3]) == pytest.approx(math.pi / 2 * 1.5**2)

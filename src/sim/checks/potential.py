@@ -1,6 +1,6 @@
 """Validation of stepped pair potentials (:mod:`sim.effects.potential`): the energy a gas of
-square-well disks keeps over 10⁷ events, and the jumps of g(r) at the steps, which
-equilibrium fixes.
+square-well disks keeps over 10⁷ events, the jumps of g(r) at the steps, which equilibrium
+fixes, and the pressure at low density against the exact second virial coefficient.
 
 Across a step at λσ the cavity function y(r) = g(r) e^{βu(r)} is continuous, so
 g(λσ⁺)/g(λσ⁻) = e^{−β(u_out − u_in)} (Hansen & McDonald, Theory of Simple Liquids, 4th ed.
@@ -21,6 +21,9 @@ from sim.engine.core import Engine
 from sim.engine.inputs import Boundary
 from sim.engine.overlap import first_overlap
 from sim.pipeline.initial import maxwellian, radius_for_packing, random_sequential, remove_drift
+
+#: kT = ⟨K⟩/(N − 1) of a run is brought this close to the asked temperature before it counts
+THERMALISED = 0.01
 
 
 def stepped_gas(n, phi, temperature, steps, energies, seed=0):
@@ -104,4 +107,84 @@ def step_jumps(n=1000, phi=0.2, temperature=1.0, steps=(1.3, 1.6), energies=(-1.
             f"{1 / beta:.3f}, φ = {phi}, N = {n}, {snapshots} snapshots", mean, expected,
             4.0 * error, "continuity of the cavity function: e^{−β(u_out − u_in)}",
             time.perf_counter() - started if not rows else None))
+    return rows
+
+
+def second_virial_coefficient(temperature, steps, energies):
+    """B₂/σ² = (π/2)[1 + Σ_k (λ_k² − λ_{k−1}²)(1 − e^{−ε_k/kT})] of a stepped potential in two
+    dimensions (λ_0 = 1; derived in docs/stepped-potentials.md)."""
+    edges = np.concatenate([[1.0], steps])
+    shells = np.diff(edges**2)
+    return 0.5 * math.pi * (1.0 + float(np.sum(shells * (1.0 - np.exp(
+        -np.asarray(energies) / temperature)))))
+
+
+def thermalised_gas(n, phi, temperature, steps, energies, seed=0, collisions_per_disk=20):
+    """:func:`stepped_gas` run ``collisions_per_disk`` at a time and its velocities scaled
+    back to kT = K/(N − 1) = ``temperature`` (zero momentum) until the run's kT stays within
+    ``THERMALISED`` of it: the energy the pairs take or give as they settle into their
+    shells comes out of the motion. Returns (engine, radius)."""
+    engine, radius = stepped_gas(n, phi, temperature, steps, energies, seed)
+    for _ in range(10):
+        engine.run(collisions=engine.collisions + collisions_per_disk * n)
+        kt = engine.kinetic_energy() / (n - 1)
+        if abs(kt / temperature - 1.0) < THERMALISED:
+            return engine, radius
+        engine = Engine(engine.positions(), engine.velocities() * math.sqrt(temperature / kt),
+                        radius, engine.mass, boundary=engine.boundary,
+                        potential_steps=list(steps), potential_energies=list(energies))
+    raise RuntimeError(f"kT did not settle at {temperature} within ten rescalings")
+
+
+def second_virial(n=1000, phis=(0.01, 0.02, 0.03, 0.04), temperatures=(1.0, 3.0),
+                  steps=(1.5,), energies=(-1.0,), replicas=8, collisions=400_000, samples=64,
+                  seed=0):
+    """(βP/ρ − 1)/ρ of a square-well gas at each of ``phis`` extrapolated to ρ → 0 by a
+    weighted line in ρσ², against the exact B₂/σ² (:func:`second_virial_coefficient`) at
+    the runs' mean kT, at temperatures on both sides of the Boyle temperature (kT_B/ε = 1.70
+    for λ = 1.5). At each φ, ``replicas`` independent runs (:func:`thermalised_gas`, seeds
+    from ``seed``) of about ``collisions`` collisions each: βPA = N + (N − 1) X/⟨K⟩, X the
+    collision virial (steps included) over twice the run's time, ⟨K⟩ the mean of
+    ``samples`` kinetic energies at equal times; the error of a φ's mean is the standard
+    error over its replicas, that of the intercept the line's. The replicas' kT differ by up
+    to ``THERMALISED``: each one's ratio is moved to the mean kT by the difference of B₂
+    between the two (B₂ of a well changes by 5σ² per unit of kT/ε at kT = ε)."""
+    rows = []
+    for temperature in temperatures:
+        started = time.perf_counter()
+        runs = []  # (ρσ², ratio, kT) of every replica
+        for phi in phis:
+            for replica in range(replicas):
+                engine, radius = thermalised_gas(n, phi, temperature, steps, energies,
+                                                 seed + 1000 * replica)
+                t0, c0, virial = engine.time, engine.collisions, engine.virial
+                engine.run(collisions=c0 + collisions // 8)
+                span = 8.0 * (engine.time - t0)  # about ``collisions`` collisions
+                t0, virial = engine.time, engine.virial
+                kinetic = []
+                for k in range(1, samples + 1):
+                    engine.run(time=t0 + k * span / samples)
+                    kinetic.append(engine.kinetic_energy())
+                x = (engine.virial - virial) / (2.0 * span)
+                rho = n * (2.0 * radius) ** 2  # ρσ² in the unit box
+                kt = float(np.mean(kinetic)) / (n - 1)
+                runs.append((rho, (n - 1) * x / (n * float(np.mean(kinetic))) / rho, kt))
+        rho, ratio, kts = (np.array(column) for column in zip(*runs, strict=True))
+        kt = float(np.mean(kts))
+        ratio = ratio - np.array([second_virial_coefficient(t, steps, energies) for t in kts]) \
+            + second_virial_coefficient(kt, steps, energies)
+        density, means, errors = [], [], []
+        for value in np.unique(rho):
+            mean, error = block_means(ratio[rho == value])
+            density.append(value)
+            means.append(mean)
+            errors.append(error)
+        (slope, intercept), cov = np.polyfit(density, means, 1, w=1.0 / np.asarray(errors),
+                                             cov="unscaled")
+        rows.append(Check(
+            f"B₂/σ² of a square well λ = {steps[0]}, ε = {-energies[0]:g}, from βP/ρ at "
+            f"φ = {', '.join(f'{p:g}' for p in phis)} ({replicas} runs each) to ρ → 0, "
+            f"kT/ε = {kt:.3f}, N = {n}", float(intercept),
+            second_virial_coefficient(kt, steps, energies), 4.0 * math.sqrt(cov[1, 1]),
+            "B₂ = (πσ²/2)[1 + (λ² − 1)(1 − e^{βε})], exact", time.perf_counter() - started))
     return rows

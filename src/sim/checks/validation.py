@@ -30,7 +30,7 @@ from sim.checks import dsmc
 from sim.checks.gases import cooling_gas, equilibrated_gas
 from sim.checks.jamming import compression_eos, jamming_density
 from sim.checks.melting import small_n_pressure
-from sim.checks.potential import energy_conservation, step_jumps
+from sim.checks.potential import energy_conservation, second_virial, step_jumps
 from sim.checks.rough import rough_cooling, rough_equipartition
 from sim.checks.rows import Check, block_means, ratio_of_means
 from sim.engine.core import Engine
@@ -489,4 +489,5 @@ STUDIES = {
     "melting_small_n": small_n_pressure,
     "potential_energy": energy_conservation,
     "potential_steps": step_jumps,
+    "potential_b2": second_virial,
 }

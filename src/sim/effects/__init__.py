@@ -89,7 +89,7 @@ EFFECTS = (
            ("compression_eos", "jamming_density",
             "test_growth.py::test_growing_gas_never_overlaps"), ("growth",)),
     Effect("potential", (), ("potential.steps", "potential.energies", "growth.rate"),
-           ("potential_energy", "potential_steps",
+           ("potential_energy", "potential_steps", "potential_b2",
             "test_potential.py::test_a_square_well_gas_keeps_its_energy_and_its_pair_states"),
            ("square_well",)),
     Effect("unwrap", ("images",), ("observe.mean_squared_displacement",),
