@@ -147,9 +147,9 @@ def draw_starts(records, out, results):
 
 
 def draw_bond_order(records, todo, out, results):
-    """The last snapshot of the N = 128² run nearest φ = 0.708 whose run file is here, every
-    disk coloured by the phase of its ψ₆, and |g₆(r)| of the last snapshot of every
-    N = 128² run (their traces)."""
+    """The last snapshot of the N = 128² run nearest φ = 0.708 whose run file is here at the
+    length of its record, every disk coloured by the phase of its ψ₆, and |g₆(r)| of the
+    last snapshot of every N = 128² run (their traces)."""
     large = [r for r in records if r["n"] == TRACED and "trace" in r]
     here = [p for p in todo if p.group.n == TRACED and (p.folder / "run.h5").exists()]
     if not large:
@@ -173,12 +173,17 @@ def draw_bond_order(records, todo, out, results):
             run_data = open_run(point.folder / "run.h5")
         except RunFileError:  # --report while the study runs it on: the next one
             continue
+        recorded = next(r["collisions_per_disk"] for r in records if
+                        (r["group"], r["phi"]) == (point.group.name, point.phi))
         with run_data:
             last = run_data.isel(time=-1)
+            per_disk = float(last["collisions"].values) / point.group.n
             position, psi = last["position"].values, last["bond_order"].values
             radius = run_data["radius"].values
             box = tuple(run_data.attrs["box"])
             seed = run_data.attrs["seed"]
+        if per_disk != recorded:  # a run made again, cut short before its record's length
+            continue
         psi = psi[:, 0] + 1j * psi[:, 1]
         angle = Normalize(-np.pi / 6, np.pi / 6)
         hue = plt.get_cmap("hsv")(angle(np.angle(psi) / 6.0))
@@ -188,8 +193,8 @@ def draw_bond_order(records, todo, out, results):
                      label="orientation of the local hexagon, arg(ψ₆)/6 (rad); "
                            "brightness |ψ₆|")
         left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[])
-        left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start, last "
-                       f"snapshot (seed {seed})", fontsize=10)
+        left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start, after "
+                       f"{per_disk:.3g} collisions per disk (seed {seed})", fontsize=10)
         break
     else:  # a clone with the committed results alone: the snapshot needs a run file
         left.text(0.5, 0.5, "no run file of N = 128² here:\nthe snapshot is drawn where the "

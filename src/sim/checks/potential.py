@@ -119,21 +119,29 @@ def second_virial_coefficient(temperature, steps, energies):
         -np.asarray(energies) / temperature)))))
 
 
-def thermalised_gas(n, phi, temperature, steps, energies, seed=0, collisions_per_disk=20):
+def thermalised_gas(n, phi, temperature, steps, energies, seed=0, collisions_per_disk=20,
+                    samples=16):
     """:func:`stepped_gas` run ``collisions_per_disk`` at a time and its velocities scaled
-    back to kT = K/(N − 1) = ``temperature`` (zero momentum) until the run's kT stays within
-    ``THERMALISED`` of it: the energy the pairs take or give as they settle into their
-    shells comes out of the motion. Returns (engine, radius)."""
+    by √(T/kT) until the mean kT = K/(N − 1) (zero momentum) of ``samples`` equal times of
+    such a run is within ``THERMALISED`` of ``temperature``: the energy the pairs take or
+    give as they settle into their shells comes out of the motion. Returns (engine,
+    radius)."""
     engine, radius = stepped_gas(n, phi, temperature, steps, energies, seed)
-    for _ in range(10):
-        engine.run(collisions=engine.collisions + collisions_per_disk * n)
-        kt = engine.kinetic_energy() / (n - 1)
+    for _ in range(20):
+        t0, c0 = engine.time, engine.collisions
+        engine.run(collisions=c0 + collisions_per_disk * n)
+        span, t0 = engine.time - t0, engine.time
+        kinetic = []
+        for k in range(1, samples + 1):
+            engine.run(time=t0 + k * span / samples)
+            kinetic.append(engine.kinetic_energy())
+        kt = float(np.mean(kinetic)) / (n - 1)
         if abs(kt / temperature - 1.0) < THERMALISED:
             return engine, radius
         engine = Engine(engine.positions(), engine.velocities() * math.sqrt(temperature / kt),
                         radius, engine.mass, boundary=engine.boundary,
                         potential_steps=list(steps), potential_energies=list(energies))
-    raise RuntimeError(f"kT did not settle at {temperature} within ten rescalings")
+    raise RuntimeError(f"kT did not settle at {temperature} within twenty rescalings")
 
 
 def second_virial(n=1000, phis=(0.01, 0.02, 0.03, 0.04), temperatures=(1.0, 3.0),
