@@ -10,6 +10,7 @@ import pytest
 
 from conftest import assert_no_overlap, distances
 from sim.checks.potential import second_virial_coefficient
+from sim.effects.potential import loop_values
 from sim.engine import Boundary, Engine
 from sim.pipeline.runner import build_engine
 from variants import UNREACHED_THERMAL_WALL, compose_scene
@@ -141,3 +142,25 @@ def test_the_second_virial_coefficient_is_the_hard_cores_and_vanishes_at_boyles_
     boyle = 1.0 / math.log(1.5**2 / (1.5**2 - 1.0))
     assert second_virial_coefficient(boyle, [1.5], [-1.0]) == pytest.approx(0.0, abs=1e-12)
     assert second_virial_coefficient(1.0, [1.5], [1e3]) == pytest.approx(math.pi / 2 * 1.5**2)
+
+
+def test_a_table_of_potentials_per_species_pair_is_built_and_an_asymmetric_one_refused():
+    """Engine keywords: one potential per species pair, with as many steps as each has (none:
+    hard disks); the table must be [s][s] and symmetric."""
+    context = {"n_species": 2}
+    table = [[[1.5], []], [[], [1.2, 1.4]]]
+    energies = [[[-1.0], []], [[], [0.5, -0.5]]]
+    value = loop_values({"potential_steps": table, "potential_energies": energies},
+                        context)["pair_interaction"]
+    assert value.count.tolist() == [[1, 0], [0, 2]]
+    assert value.steps[1, 1].tolist() == [1.2, 1.4] and value.energies[0, 0, 0] == -1.0
+    assert value.reach.tolist() == [1.5, 1.4]
+    one = loop_values({"potential_steps": [1.5], "potential_energies": [-1.0]},
+                      context)["pair_interaction"]
+    assert one.count.tolist() == [[1, 1], [1, 1]]
+    with pytest.raises(ValueError, match="symmetric"):
+        loop_values({"potential_steps": [[[1.5], [1.3]], [[1.4], [1.5]]],
+                     "potential_energies": [[[-1.0], [-1.0]], [[-1.0], [-1.0]]]}, context)
+    with pytest.raises(ValueError, match="table"):
+        loop_values({"potential_steps": [[[1.5]]], "potential_energies": [[[-1.0]]]},
+                    context)

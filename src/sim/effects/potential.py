@@ -136,11 +136,11 @@ def loop_values(keywords, context):
                           "potential_steps")
         return {"pair_interaction": None}
     n_species = context["n_species"]
-    if np.ndim(steps[0]) == 0:  # one potential for every pair
+    if not isinstance(steps[0], list | tuple | np.ndarray):  # one potential for every pair
         steps = [[list(steps)] * n_species] * n_species
         energies = [[list(energies or [])] * n_species] * n_species
-    if (len(steps) != n_species or any(len(row) != n_species for row in steps)
-            or np.shape(energies)[:2] != (n_species, n_species)):
+    if any(len(table or []) != n_species or any(len(row) != n_species for row in table)
+           for table in (steps, energies)):
         raise refused("Engine", "potential_steps", steps, f"a list for every pair, or a "
                       f"[{n_species}][{n_species}] table of lists, one per species pair")
     for a in range(n_species):
