@@ -15,9 +15,11 @@ from sim.pipeline.initial import (
 )
 
 
-def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None):
-    """Elastic equal-size disks in the periodic unit box at T = 1 with zero total momentum,
-    run ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
+def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None,
+                     temperature=1.0, **keywords):
+    """Elastic equal-size disks in the periodic unit box at ``temperature`` with zero total
+    momentum, with the Engine keywords ``keywords`` (a stepped potential, say), run
+    ``collisions_per_disk`` from a lattice (φ > 0.3) or random placement."""
     radius = radius_for_packing(n, phi)
     periodic = (True, True)
     mass = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,))
@@ -25,9 +27,9 @@ def equilibrated_gas(n, phi, collisions_per_disk, seed=1, mass=1.0, species=None
         position = hexagonal_lattice(n, radius, periodic=periodic, seed=seed)
     else:
         position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
-    velocity = remove_drift(maxwellian(mass, 1.0, seed=seed + 1), mass)
+    velocity = remove_drift(maxwellian(mass, temperature, seed=seed + 1), mass)
     engine = Engine(position, velocity, radius, mass, species,
-                    boundary=Boundary(periodic=periodic))
+                    boundary=Boundary(periodic=periodic), **keywords)
     engine.run(collisions=int(collisions_per_disk * n))
     return engine, radius
 

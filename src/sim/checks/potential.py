@@ -14,30 +14,24 @@ import math
 import time
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from sim.analysis.observers import RadialDistribution
+from sim.checks.gases import equilibrated_gas
 from sim.checks.rows import Check, block_means
 from sim.engine.core import Engine
-from sim.engine.inputs import Boundary
 from sim.engine.overlap import first_overlap
-from sim.pipeline.initial import maxwellian, radius_for_packing, random_sequential, remove_drift
 
 #: kT = ⟨K⟩/(N − 1) of a run is brought this close to the asked temperature before it counts
 THERMALISED = 0.01
 
 
 def stepped_gas(n, phi, temperature, steps, energies, seed=0):
-    """Equal disks (mass 1) at packing fraction ``phi`` in the periodic unit box with the
-    stepped potential ``steps``, ``energies``, randomly placed, Maxwellian at ``temperature``
-    with zero total momentum. Returns (engine, radius)."""
-    radius = radius_for_packing(n, phi)
-    periodic = (True, True)
-    position = random_sequential(np.full(n, radius), periodic=periodic, seed=seed)
-    mass = np.ones(n)
-    velocity = remove_drift(maxwellian(mass, temperature, seed=seed + 1), mass)
-    engine = Engine(position, velocity, radius, mass, boundary=Boundary(periodic=periodic),
-                    potential_steps=list(steps), potential_energies=list(energies))
-    return engine, radius
+    """Equal disks (mass 1) at packing fraction ``phi`` ≤ 0.3 in the periodic unit box with
+    the stepped potential ``steps``, ``energies``, randomly placed, Maxwellian at
+    ``temperature`` with zero total momentum (:func:`sim.checks.gases.equilibrated_gas`, not
+    run). Returns (engine, radius)."""
+    return equilibrated_gas(n, phi, 0, seed, temperature=temperature,
+                            potential_steps=list(steps), potential_energies=list(energies))
 
 
 def energy_conservation(n=1000, phi=0.3, temperatures=(0.5, 1.0, 5.0), events=10_000_000,
@@ -70,29 +64,24 @@ def energy_conservation(n=1000, phi=0.3, temperatures=(0.5, 1.0, 5.0), events=10
 def step_jumps(n=1000, phi=0.2, temperature=1.0, steps=(1.3, 1.6), energies=(-1.0, 0.5),
                snapshots=4000, blocks=8, width=0.01, fitted=6, seed=0):
     """g(λσ⁺)/g(λσ⁻) at every step of a two-step potential (a well inside a shoulder) against
-    e^{−β(u_out − u_in)}: g of ``snapshots`` snapshots one collision per disk apart, in
+    e^{−β(u_out − u_in)}: g (:class:`sim.analysis.observers.RadialDistribution`) of
+    ``snapshots`` snapshots one collision per disk apart, in
     ``blocks`` blocks (the error: the standard error of the blocks' ratios), bins of
     ``width`` σ with edges on the steps, a line through the ``fitted`` bins on each side."""
     started = time.perf_counter()
-    engine, radius = stepped_gas(n, phi, temperature, steps, energies, seed)
-    sigma = 2.0 * radius
+    engine, _ = stepped_gas(n, phi, temperature, steps, energies, seed)
     engine.run(collisions=50 * n)
     reach = max(steps) + fitted * width
-    edges = np.arange(0.0, reach + 0.5 * width, width)
-    counts = np.zeros((blocks, edges.size - 1))
+    g_of = RadialDistribution(int(round(reach / width)), reach, engine)
+    g = np.zeros((blocks, g_of.shape[0]))
     kinetic = []
     per_block = snapshots // blocks
     for s in range(per_block * blocks):
         engine.run(collisions=engine.collisions + n)
-        tree = cKDTree(np.mod(engine.positions(), 1.0), boxsize=1.0)
-        pairs = tree.sparse_distance_matrix(tree, reach * sigma, output_type="ndarray")
-        distance = pairs["v"][pairs["i"] < pairs["j"]] / sigma
-        counts[s // per_block] += np.histogram(distance, edges)[0]
+        g[s // per_block] += g_of(engine, engine.time, engine.positions(), None) / per_block
         kinetic.append(engine.kinetic_energy())
     beta = (n - 1) / float(np.mean(kinetic))
-    shell = math.pi * (edges[1:] ** 2 - edges[:-1] ** 2) * sigma**2  # unit box: area 1
-    g = counts / (per_block * 0.5 * n * (n - 1) * shell)
-    centres = 0.5 * (edges[1:] + edges[:-1])
+    centres = g_of.coords["r"]
     u = np.concatenate([[0.0], energies, [0.0]])
     rows = []
     for k, step in enumerate(steps):

@@ -44,8 +44,9 @@ from sim.engine.kinematics import (
     pair_contact_time,
     pair_exit_time,
 )
-from sim.engine.pairs import collide, pair_state, rules, set_pair_state
+from sim.engine.pairs import collide, hard_core_time, pair_state, rules, set_pair_state
 from sim.engine.parameters import per_disk
+from sim.engine.sizing import periodic_room
 from sim.engine.stamps import invalidate
 
 KEYWORDS = {
@@ -86,17 +87,18 @@ def check_config(cfg):
 
 
 def check_scene(cfg, scene):
-    """The steps within the box's periodic-image rule: two disks of the largest radii R_1,
-    R_2 have no pair event beyond λ_K (R_1 + R_2), which must stay below half a periodic
-    side, where a separation is taken to its nearest image."""
+    """The steps within the box's periodic-image rule (the engine's,
+    :func:`sim.engine.sizing.periodic_room`, for reaches λ_K R_i): two disks of the largest
+    radii R_1, R_2 have no pair event beyond λ_K (R_1 + R_2), which must stay below half a
+    periodic side, where a separation is taken to its nearest image."""
     steps = list(cfg.potential.steps)
-    sides = [side for side, wraps in zip(scene.boundary.size, scene.boundary.periodic,
-                                         strict=True) if wraps]
-    if not steps or not sides:
+    if not steps:
         return
-    r_2, r_1 = np.sort(scene.radius)[-2:] if scene.radius.size > 1 else (0.0, scene.radius[0])
-    largest = 0.5 * min(sides) / (r_1 + r_2)
-    if steps[-1] >= largest:
+    box = scene.boundary.size
+    room, axis, a_1, a_2 = periodic_room(box, scene.boundary.periodic,
+                                         steps[-1] * np.asarray(scene.radius))
+    if room <= 0.0:
+        largest = steps[-1] * 0.5 * box[axis] / (a_1 + a_2)
         raise ConfigError("potential.steps", steps, f"steps below {largest:.4g} σ in this "
                           f"periodic box: a pair's last step must stay within half a side "
                           f"(λ_K (R_1 + R_2) < L/2, R_1, R_2 the largest radii)")
@@ -179,14 +181,10 @@ def step_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     the outer one reached moving out (none beyond the last step)."""
     a, b = per_disk(disks.species, i), per_disk(disks.species, j)
     if value.count[a, b] == 0:  # a pair of hard disks
-        if may_touch_before(rx, ry, vx, vy, sigma, tau):
-            return pair_contact_time(rx, ry, vx, vy, sigma), CORE
-        return INF, CORE
-    if state == 0:
-        outer = value.steps[a, b, value.count[a, b] - 1] * sigma
-        if may_touch_before(rx, ry, vx, vy, outer, tau):
-            return pair_contact_time(rx, ry, vx, vy, outer), INWARD
-        return INF, INWARD
+        return hard_core_time(rx, ry, vx, vy, sigma, tau), CORE
+    if state == 0:  # the last step, from beyond it
+        return hard_core_time(rx, ry, vx, vy, value.steps[a, b, value.count[a, b] - 1] * sigma,
+                              tau), INWARD
     inner = sigma if state == 1 else value.steps[a, b, state - 2] * sigma
     if may_touch_before(rx, ry, vx, vy, inner, tau):
         t_in = pair_contact_time(rx, ry, vx, vy, inner)

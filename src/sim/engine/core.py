@@ -55,6 +55,7 @@ from sim.engine.sizing import (
     first_event_time,
     grid_cells,
     packing_fraction_around_disks,
+    periodic_room,
     shell_lead,
     shell_ratio,
     stall_interval,
@@ -220,22 +221,14 @@ class Engine(Running, Observables, Checkpoints):
         lead = shell_lead(phi_small) if lead is None else lead
         delta_small = 0.5 * (ratio - 1.0) * 2.0 * median
         max_small = float(a_sizing[~is_big].max())
-        # the two largest reaches: two disks whose shells overlap are less than
-        # a_i + a_j + 4 δ apart (shell centres within a_i + δ + a_j + δ, each disk within δ of
-        # its centre)
-        r_2, r_1 = (np.sort(a_sizing)[-2:] if n > 1 else (0.0, a_sizing[0]))
-        for axis in range(2):
-            if self.periodic[axis]:
-                # predictions take the nearest image of a separation: that is the image in
-                # which the pair can have an event only while a_1 + a_2 + 4 δ ≤ L/2
-                limit = 0.25 * (0.5 * box[axis] - r_1 - r_2)
-                if limit <= 0.0:
-                    what, a_sum = (("radii", "R_1 + R_2") if reaches is None
-                                   else ("pair events reaching", "a_1 + a_2"))
-                    raise ValueError(f"periodic box side {box[axis]} is too small for disks of "
-                                     f"{what} {r_1:g} and {r_2:g}: it must exceed "
-                                     f"2 ({a_sum}) = {2.0 * (r_1 + r_2):g}")
-                delta_small = min(delta_small, limit)
+        room, axis, r_1, r_2 = periodic_room(box, self.periodic, a_sizing)
+        if room <= 0.0:
+            what, a_sum = (("radii", "R_1 + R_2") if reaches is None
+                           else ("pair events reaching", "a_1 + a_2"))
+            raise ValueError(f"periodic box side {box[axis]} is too small for disks of "
+                             f"{what} {r_1:g} and {r_2:g}: it must exceed "
+                             f"2 ({a_sum}) = {2.0 * (r_1 + r_2):g}")
+        delta_small = min(delta_small, room)
         delta = np.full(n, delta_small)
         reach = max_small + delta_small
         cells = grid_cells(box, 2.0 * reach, cell_limit(n))

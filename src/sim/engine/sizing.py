@@ -169,3 +169,19 @@ def packing_fraction_around_disks(position, radius, box):
     covered, _, _ = np.histogram2d(x, y, bins=edges, weights=np.pi * radius**2)
     bin_area = box[0] * box[1] / (nx * ny)
     return float(np.sum(count * covered) / (bin_area * n))
+
+
+def periodic_room(box, periodic, reaches):
+    """(room, axis, a_1, a_2): the room δ ≤ room for neighbour shells that the nearest-image
+    rule leaves on the periodic axes, its axis (None without one), and the two largest
+    reaches a_1 ≥ a_2 of ``reaches`` float64[n]. Predictions take the nearest image of a
+    separation, in which a pair can have an event only while a_1 + a_2 + 4 δ ≤ L/2 (two
+    disks whose shells overlap are less than a_i + a_j + 4 δ apart: shell centres within
+    a_i + δ + a_j + δ, each disk within δ of its centre): room = (L/2 − a_1 − a_2)/4 on the
+    shortest periodic side, ∞ without one; at most 0, the box is too small."""
+    a_2, a_1 = np.sort(reaches)[-2:] if reaches.size > 1 else (0.0, float(reaches[0]))
+    sides = [(float(box[axis]), axis) for axis in range(2) if periodic[axis]]
+    if not sides:
+        return math.inf, None, a_1, a_2
+    side, axis = min(sides)
+    return 0.25 * (0.5 * side - a_1 - a_2), axis, a_1, a_2
