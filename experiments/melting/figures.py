@@ -27,6 +27,8 @@ TRACED = 16384
 #: g₆(r) in this many bins up to this many diameters
 G6_BINS, G6_REACH = 120, 12.0
 
+#: the states of a measured point (study.status) and what the legend says of them
+STATES = {"done": "", "running": ", still running", "longest": ", at its longest run, not done"}
 #: the panels of the equation of state: (N, box) and the groups drawn in each
 PANELS = ((72, "1:1"), (72, "9:8√3/2"), (224, "1:1"), (870, "1:1"), (870, "29:30√3/2"),
           (16384, "1:1"))
@@ -59,16 +61,15 @@ def draw_equation_of_state(records, out, results):
         mine = [r for r in records if r["n"] == n and r["box"] == box]
         for start, marker, colour in (("compressed", "o", "C0"), ("melted", "s", "C1"),
                                       ("lattice", "^", "C4")):
-            for done in (True, False):
+            for state, caption in STATES.items():
                 rows = sorted((r for r in mine if r["start"] == start
-                               and (r["status"] == "done") == done), key=lambda r: r["phi"])
+                               and r["status"] == state), key=lambda r: r["phi"])
                 if rows:
                     ax.errorbar([r["phi"] for r in rows], [r["bPd2"] for r in rows],
                                 [r["err"] for r in rows], fmt=marker, ms=3.5, capsize=2,
                                 mfc="none" if start == "melted" else None, color=colour,
-                                alpha=1.0 if done else 0.35,
-                                label=f"sim, from a {start} start"
-                                      + ("" if done else ", not done yet"))
+                                alpha=1.0 if state == "done" else 0.35,
+                                label=f"sim, from a {start} start{caption}")
         if mine:
             lo, hi = min(r["phi"] for r in mine), max(r["phi"] for r in mine)
             inside = (phi >= lo - 0.003) & (phi <= hi + 0.003)
