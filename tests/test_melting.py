@@ -125,6 +125,31 @@ def test_a_committed_record_of_older_rules_is_run_again_to_its_recorded_length(t
     assert study._pending([point]) == [(point, 3 * g.first)]
 
 
+def test_an_adopted_point_whose_rerun_was_cut_short_goes_on_to_its_recorded_length(
+        tmp_path, monkeypatch):
+    """_pending: a point whose committed record is done but whose run here (made again for
+    what the record lacks) was stopped by a signal resumes to the record's length; once
+    that run is whole, the point is judged by it and not resumed to that length again."""
+    study = _study()
+    plan = sys.modules["plan"]
+    point = plan.points(plan.QUICK, tmp_path)[0]
+    g = point.group
+    done = {"group": g.name, "n": g.n, "box": g.box, "phi": point.phi, "start": g.start,
+            "analysis": study.ANALYSIS, "collisions_per_disk": g.first, "cpu_seconds": 5.0,
+            "err": 0.0, "converged": True, "drift": 0.0, "blocks": 100, "cut": 0,
+            "bPd2": 1.0, "status": "done"}
+    ledger = tmp_path / "melting.json"
+    ledger.write_text(json.dumps({"points": [done]}))
+    study.adopt([point], ledger)
+    with monkeypatch.context() as patch:  # a signal before the first chunk ends
+        patch.setattr(Interruption, "requested", property(lambda self: True))
+        patch.setattr(Interruption, "reason", property(lambda self: "interrupted"))
+        run(compose_config(point.overrides(g.first)), point.folder)
+    assert study._pending([point]) == [(point, g.first)]
+    assert study.advance(point, g.first)["collisions_per_disk"] == g.first
+    assert all(length > g.first for _, length in study._pending([point]))
+
+
 def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_should():
     """next_length: none for a point that meets its target (and agrees with the runs of its
     state point from other starts), has reached its longest run or failed; else its

@@ -72,9 +72,9 @@ PLAN = (
     Group("870-lattice-crystal", 870, "29:30√3/2", (0.714, 0.716, 0.718),
           "lattice", 200, 100_000, 3_000_000, 0.003),
     Group("16384-square", 16384, "1:1", (0.698, 0.704, 0.708, 0.712, 0.716),
-          "compressed", 1000, 80_000, 400_000, 0.003),
+          "compressed", 1000, 80_000, 1_200_000, 0.003),
     Group("16384-square-melted", 16384, "1:1", (0.704, 0.716),
-          "melted", 1000, 80_000, 400_000, 0.003),
+          "melted", 1000, 80_000, 1_200_000, 0.003),
 )
 
 #: a smoke run of the study: two points of N = 72, short, into a folder of the caller's

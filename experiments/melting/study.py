@@ -75,6 +75,9 @@ LEDGER = Path(__file__).resolve().parents[2] / "docs" / "results" / "melting.jso
 #: the version of :func:`analyse`'s rules a record was made with; a record of another is
 #: made anew from its run file when the study starts
 ANALYSIS = 2
+#: the stop reasons of a run file whose round has not reached its length: stopped by a
+#: signal, or still "running" in the file of a killed process
+CUT_SHORT = ("interrupted", "terminated", "running")
 
 
 def _record(point):
@@ -225,7 +228,14 @@ def _pending(todo):
     rounds = []
     for point in todo:
         record = _record(point)
-        adopted = record is not None and not (point.folder / "run.h5").exists()
+        path = point.folder / "run.h5"
+        stored, reason = stored_config(path) if path.exists() else (None, None)
+        if stored is not None and (record is None or reason in CUT_SHORT):
+            # cut short (a signal, a killed job) before the length of its round, which may be
+            # its adopted record's: it goes on to that length
+            rounds.append((point, stored.stop.collisions // point.group.n))
+            continue
+        adopted = record is not None and stored is None
         if adopted and "failed" not in record and (
                 record.get("analysis") != ANALYSIS  # of older rules
                 or ("trace" not in record and point.group.n == TRACED
@@ -235,11 +245,7 @@ def _pending(todo):
         if record is not None and record.get("analysis") != ANALYSIS:
             record = analyse(point)  # analysed by an older rule: read its run again
         if record is None:
-            if (point.folder / "run.h5").exists():  # cut short before its first analysis
-                stored = stored_config(point.folder / "run.h5")[0]
-                rounds.append((point, stored.stop.collisions // point.group.n))
-            else:
-                rounds.append((point, point.group.first))
+            rounds.append((point, point.group.first))
         elif (length := next_length(point, record, _others(point, todo))) is not None:
             rounds.append((point, length))
     return rounds
