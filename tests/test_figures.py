@@ -16,7 +16,8 @@ FIGURES = {"single_disk": "fig01_single_disk", "two_disks": "fig02_two_disks",
            "mixture_cooling": "fig07_mixture_cooling", "crater_grid": "fig08_crater_grid",
            "crater_radius": "fig09_crater_radius", "crater_speed": "fig10_crater_speed",
            "crater_gravity": "fig11_crater_gravity", "rough_cooling": "fig12_rough_cooling",
-           "crater_rough": "fig13_crater_rough", "jamming": "fig14_jamming"}
+           "crater_rough": "fig13_crater_rough", "jamming": "fig14_jamming",
+           "stepped_potentials": "fig15_stepped_potentials"}
 QUICK_STAGES = ("single_disk", "two_disks", "gas_snapshot", "maxwell_boltzmann", "mixture")
 
 
@@ -168,8 +169,21 @@ def check_jamming(out):
     assert np.all(np.abs(jamming[:, 4] - 4.0) < 0.4) and np.all(jamming[:, 6] < 0.3)
 
 
+def check_stepped_potentials(out):
+    # kT, B₂/σ² ± error, exact, slope, runs: B₂ from ρ → 0 within four errors of the exact
+    # value, below the Boyle temperature negative and above it positive; g(r) jumps at each
+    # step by e^{−βΔu} within four errors
+    virial = numbers(out, "stepped_potentials")
+    assert np.all(np.abs(virial[:, 1] - virial[:, 3]) < 4 * virial[:, 2])
+    assert virial[0, 0] < 1.70 < virial[1, 0] and virial[0, 3] < 0 < virial[1, 3]
+    jumps = key_values(out, "stepped_potentials")
+    for k in (0, 1):
+        ratio, error = float(jumps[f"jump_{k}_ratio"]), float(jumps[f"jump_{k}_error"])
+        assert 0 < error and abs(ratio - float(jumps[f"jump_{k}_expected"])) < 4 * error
+
+
 def check_movies(out):
-    for movie in ("two_disks", "crater", "cooling"):
+    for movie in ("two_disks", "crater", "cooling", "square_well"):
         assert (out / f"movie_{movie}.mp4").stat().st_size > 10_000
 
 
@@ -196,9 +210,11 @@ def test_quick_figures_of_the_small_scenes(tmp_path):
 def test_stages_that_read_one_run_are_made_in_one_process(tmp_path):
     groups = batches(list(STAGES), True, tmp_path)
     assert sorted(name for group in groups for name in group) == sorted(STAGES)
-    # the gas snapshot and its speed distribution read one run
+    # the gas snapshot and its speed distribution read one run, and so do the figure of
+    # stepped potentials and the movie of square-well disks splitting
     assert ["gas_snapshot", "maxwell_boltzmann"] in groups
-    assert len(groups) == len(STAGES) - 1
+    assert ["stepped_potentials", "movies"] in groups
+    assert len(groups) == len(STAGES) - 2
 
 
 @pytest.mark.slow

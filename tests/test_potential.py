@@ -1,7 +1,7 @@
 """Stepped pair potentials (sim.effects.potential): square wells and shoulders around the hard
-core. Every test here runs the quick suite's one compiled variant of them (the square_well
-scene's: a stepped potential and thermal walls, every disk alike; a pair of disks gets a
-thermal wall it never reaches)."""
+core. Every quick test here runs the quick suite's one compiled variant of them (the
+square_well scene's: a stepped potential and thermal walls, every disk alike; a pair of disks
+gets a thermal wall it never reaches); inelastic cores and mixtures are slow tests."""
 
 import math
 
@@ -12,6 +12,7 @@ from conftest import assert_no_overlap, distances
 from sim.checks.potential import second_virial_coefficient
 from sim.effects.potential import loop_values
 from sim.engine import Boundary, Engine
+from sim.pipeline.initial import maxwellian, random_sequential, remove_drift
 from sim.pipeline.runner import build_engine
 from variants import UNREACHED_THERMAL_WALL, compose_scene
 
@@ -64,6 +65,23 @@ def test_a_square_well_gas_keeps_its_energy_and_its_pair_states():
     assert engine.collisions > 20 * engine.n
     assert engine.events > engine.collisions + engine.n  # crossings and bounces as well
     assert engine.potential_energy() < start - 0.5 * engine.n  # half a well per disk more
+
+
+@pytest.mark.slow  # inelastic cores with a stepped potential: no quick variant
+def test_cohesive_granular_disks_say_what_their_inelastic_cores_dissipated():
+    """The square_well scene with inelastic cores (ξ = 0.8): kinetic plus potential energy
+    plus what the cores dissipated, less the work of the thermal walls, constant to
+    round-off; no overlap; the cores dissipate, and the steps, elastic, do not."""
+    engine = build_engine(compose_scene("square_well", "restitution.disk=0.8"))
+    total = engine.kinetic_energy() + engine.potential_energy()
+    for end in np.linspace(0.5, 3.0, 4):
+        engine.run(time=end)
+        assert_no_overlap(engine)
+        assert engine.kinetic_energy() + engine.potential_energy() \
+            + engine.dissipated_energy - engine.wall_work \
+            == pytest.approx(total, rel=1e-12, abs=1e-12 * engine.kinetic_energy())
+    assert engine.dissipated_energy > 0.01 * engine.kinetic_energy()
+    assert engine.events > engine.collisions + engine.n
 
 
 def test_pair_states_and_energy_resume_to_the_same_bits():
@@ -164,3 +182,45 @@ def test_a_table_of_potentials_per_species_pair_is_built_and_an_asymmetric_one_r
     with pytest.raises(ValueError, match="table"):
         loop_values({"potential_steps": [[[1.5]]], "potential_energies": [[[-1.0]]]},
                     context)
+
+
+@pytest.mark.slow  # a mixture with a stepped potential: no quick variant
+def test_a_mixture_keeps_the_potential_of_each_species_pair():
+    """Two species (radii 1 : 1.4, masses 1 : 2) in a periodic box, a well between small
+    disks, a shoulder of two steps between large ones and hard cores between the two: energy
+    conserved to round-off, no overlap, and every listed pair's state the shell its distance
+    over σ_ij puts it in, by its species pair's steps."""
+    n, radius = 400, 0.01
+    species = np.arange(n) % 2
+    radii = np.where(species == 0, radius, 1.4 * radius)
+    mass = np.where(species == 0, 1.0, 2.0)
+    position = random_sequential(radii, periodic=(True, True), seed=3)
+    velocity = remove_drift(maxwellian(mass, 1.0, seed=4), mass)
+    table = [[[1.5], []], [[], [1.2, 1.4]]]
+    energies = [[[-1.0], []], [[], [0.8, 0.3]]]
+    engine = Engine(position, velocity, radii, mass, species,
+                    boundary=Boundary(periodic=(True, True)), potential_steps=table,
+                    potential_energies=energies)
+    total = engine.kinetic_energy() + engine.potential_energy()
+    edges = {(0, 0): [1.0, 1.5], (1, 1): [1.0, 1.2, 1.4]}
+    for k in range(1, 6):
+        engine.run(collisions=20 * n * k)
+        assert_no_overlap(engine)
+        assert engine.kinetic_energy() + engine.potential_energy() == pytest.approx(
+            total, rel=1e-12)
+        r = distances(engine) / (radii[:, None] + radii[None, :])
+        for (i, j), shell in _pair_states(engine).items():
+            edge = edges.get((int(species[i]), int(species[j])))
+            if edge is None:  # hard cores: no shell but 0
+                assert shell == 0
+                continue
+            outer = edge[shell] if shell > 0 else np.inf
+            inner = edge[shell - 1] if shell > 0 else edge[-1]
+            assert inner * (1 - 1e-9) < r[i, j] < outer * (1 + 1e-9)
+    assert engine.potential_energy() != 0.0
+    assert engine.events > engine.collisions + n
+
+
+def _pair_states(engine):
+    """{(i, j): shell} of every listed pair (user order, i < j)."""
+    return {pair: shell for shell, pairs in _shells_by_state(engine).items() for pair in pairs}

@@ -1,6 +1,6 @@
 """Movies (beyond the study), MP4s drawn by :mod:`sim.figures.movie` beside the figures: the
-two-disk scene, the crater impact coloured by speed, and the cooling gas with its largest cluster
-red.
+two-disk scene, the crater impact coloured by speed, the cooling gas with its largest cluster
+red, and square-well disks splitting into liquid and vapour, their largest drop red.
 
 Every frame is a snapshot of its run, so none is drawn in free flight across contacts. Two
 disks: snapshots every 0.0125 (``output.every_time``), 60 frames per second, in which a disk
@@ -15,18 +15,22 @@ the first frames and hardly at all in the last; instead a frame at each snapshot
 collisions (``output.every_collisions``: a disk takes part in 1.5 collisions between frames
 on average, and so moves about as far at every stage), until t = 100, long enough for the clusters
 to grow, the clock showing the unequal steps in time. Quick: 1000 disks, every 200 collisions
-(0.4 per disk) until t = 40, a box too small for clusters to last.
+(0.4 per disk) until t = 40, a box too small for clusters to last. Square well: the run of
+figure 15's third panel (:func:`sim.figures.stepped_potentials.split_run`), a frame at each
+snapshot (every 5 collisions per disk), disks linked into clusters within the well.
 """
 
 from sim.analysis.crater import crater_overrides
 from sim.figures.movie import make_movie
+from sim.figures.stepped_potentials import split_run
 
 NAME = "movies"
 
 #: label: make_movie's options
 MOVIES = {"two_disks": {"color": "speed", "fps": 60.0, "start": 8.0},
           "crater": {"color": "speed", "speed_scale": "log", "fps": 30.0},
-          "cooling": {"color": "cluster", "fps": 30.0, "at_snapshots": True}}
+          "cooling": {"color": "cluster", "fps": 30.0, "at_snapshots": True},
+          "square_well": {"color": "cluster", "fps": 30.0, "at_snapshots": True}}
 
 
 def runs(quick):
@@ -40,6 +44,7 @@ def runs(quick):
         "cooling": ["scenario=cooling", *(["disks.n=1000"] if quick else []),
                     "stop.collisions=null", f"stop.time={40.0 if quick else 100.0}",
                     f"output.every_collisions={200 if quick else 1500}"],
+        "square_well": split_run(quick),
     }
 
 
