@@ -6,10 +6,10 @@ STAMP  := $(VENV)/.installed
 # the results the docs and the README include; only the targets below write them
 RESULTS := docs/results
 
-.PHONY: help venv run test validate tutorials bench speed figures accuracy melting dsmc readme docs lint wheel clean
+.PHONY: help venv run test validate cluster-test tutorials bench speed figures accuracy melting dsmc readme docs lint wheel clean
 
 help:  ## list the targets
-	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-13s %s\n", $$1, $$2}'
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,8 +34,11 @@ test: $(STAMP)  ## quick tests (long physics runs are marked slow), one worker p
 	exit $$status
 
 validate: $(STAMP)  ## every test, slow physics runs included; the table into outputs/validation/ and docs/results/
-	$(PY) -m pytest -q -m "" --hypothesis-profile=validate
+	$(PY) -m pytest -q -m "not cluster" --hypothesis-profile=validate
 	cp outputs/validation/table.md $(RESULTS)/validation.md
+
+cluster-test: $(STAMP)  ## sweeps through a real SLURM of one node made here (as root: installs slurm-wlm, munge)
+	$(PY) -m pytest -q -rs -p no:xdist -m cluster tests/cluster
 
 tutorials: $(STAMP)  ## run the tutorial notebooks (nbmake)
 	$(PY) -m pytest -q -p no:cacheprovider --nbmake --nbmake-timeout=600 docs/tutorials

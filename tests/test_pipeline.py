@@ -2,6 +2,7 @@
 continues to the same bits, sweeps run. Bad values and their one-line refusals are
 ``test_hostile.py``'s."""
 
+import math
 import subprocess
 import sys
 
@@ -13,6 +14,7 @@ import yaml
 from sim.analysis.datasets import open_run, open_sweep
 from sim.pipeline import runner
 from sim.pipeline.config import ConfigError
+from sim.pipeline.overrides import value_of
 from sim.storage.errors import RunFileError
 from sim.storage.h5md import RunWriter
 from sim.storage.inspect import summary
@@ -304,6 +306,47 @@ def test_the_cluster_launcher_config_composes_to_slurm():
     launcher = cfg.hydra.launcher
     assert launcher._target_.endswith("SlurmLauncher")
     assert (launcher.cpus_per_task, launcher.array_parallelism) == (1, 200)
+
+
+def test_a_slurm_sweep_asks_for_what_its_runs_need(monkeypatch):
+    """sim.pipeline.cluster: each job's memory from the largest run's estimate and a margin,
+    its time limit twice the longest run at the assumed rate and the start's minutes, unless
+    the command line gives them; a partition the cluster lacks, or a time beyond its
+    partition's limit, named in one line. SLURM's times read in minutes."""
+    from sim.pipeline import cluster
+    from sim.pipeline.resources import estimate
+
+    monkeypatch.setattr(cluster, "partitions", lambda: ({"short": 60.0, "long": None}, "short"))
+    args = ["scenario=gas", "disks.n=1000,100000", "stop.collisions=6e8",
+            "hydra/launcher=cluster", "-m"]
+    assert cluster.slurm_launcher(args)
+    configs = [compose_scene("gas", f"disks.n={n}", "stop.collisions=600000000")
+               for n in (1000, 100000)]
+    asked, line = cluster.job_resources(args, configs)
+    largest = max(estimate(cfg)["memory"][0] for cfg in configs)
+    memory = math.ceil(cluster.MEMORY_MARGIN * largest / 2**30)
+    minutes = math.ceil(cluster.START_MINUTES + 2 * 6e8 / cluster.ASSUMED_RATE / 60)
+    assert value_of(asked, "hydra.launcher.mem_gb") == str(memory)
+    assert value_of(asked, "hydra.launcher.timeout_min") == str(minutes) == "25"
+    assert f"{memory} GB and {minutes} min (estimated), partition the default" in line
+    given = cluster.job_resources([*args[:-1], "hydra.launcher.mem_gb=7",
+                                   "hydra.launcher.timeout_min=30", "-m"], configs)[0]
+    assert value_of(given, "hydra.launcher.mem_gb") == "7"
+    assert value_of(given, "hydra.launcher.timeout_min") == "30"
+    with pytest.raises(ConfigError, match="at most the 60 minutes of partition short"):
+        cluster.job_resources([*args[:-1], "hydra.launcher.timeout_min=61", "-m"], configs)
+    assert cluster.job_resources([*args[:-1], "hydra.launcher.partition=long",
+                                  "hydra.launcher.timeout_min=100000", "-m"], configs)
+    with pytest.raises(ConfigError, match="hydra.launcher.partition='gpu'.*: long, short"):
+        cluster.job_resources([*args[:-1], "hydra.launcher.partition=gpu", "-m"], configs)
+    unbounded = [compose_scene("crater", "stop.collisions=null")]  # to its energy fraction
+    asked, line = cluster.job_resources(["scenario=crater", "hydra/launcher=cluster",
+                                         "hydra.launcher.partition=long", "-m"], unbounded)
+    assert value_of(asked, "hydra.launcher.timeout_min") is None and "240 min" in line
+    assert not cluster.slurm_launcher(["scenario=gas", "-m"])
+    assert cluster.minutes("30") == 30 and cluster.minutes("1:30") == 1.5
+    assert cluster.minutes("2:00:00") == 120 and cluster.minutes("1-00:00:00") == 1440
+    assert cluster.minutes("1-2") == 1560 and cluster.minutes("infinite") is None
 
 
 def test_the_wall_budget_does_not_count_compiling_the_loop(tmp_path, monkeypatch):

@@ -4,7 +4,8 @@ Each job writes ``<job dir>/job_status.yaml`` (overrides, status, run file or er
 end of the sweep ``<sweep dir>/sweep_summary.yaml`` lists them all. A failing job does not
 stop the others: in a sweep the job function returns ``{"failed": message}`` instead of
 raising, so the launcher runs every job and the entry point exits with status 1 at the end
-when any failed. A job a signal stopped returns ``{"stopped": reason}``: status STOPPED.
+when any failed. A job a signal stopped returns ``{"stopped": reason}``: status STOPPED (on a
+cluster with the signal, ``{"stopped": reason, "signal": name}``).
 """
 
 from pathlib import Path
@@ -19,8 +20,10 @@ STATUS_FILE = "job_status.yaml"
 #: the status of a job a signal stopped (its run file resumes; :mod:`sim.pipeline.sweep_stop`)
 STOPPED = "STOPPED"
 SUMMARY_FILE = "sweep_summary.yaml"
-#: Jobs of the last sweep in this process that failed (read by ``python -m sim``).
+#: Jobs of the last sweep in this process that failed, and those a signal stopped (read by
+#: ``python -m sim``).
 FAILED_JOBS = []
+STOPPED_JOBS = []
 
 
 class SweepReport(Callback):
@@ -37,6 +40,8 @@ class SweepReport(Callback):
         elif isinstance(value, dict) and "stopped" in value:  # sim.pipeline.sweep_stop
             entry["status"] = STOPPED
             entry["stop_reason"] = value["stopped"]
+            if "signal" in value:  # a job on a cluster (sim.pipeline.cluster)
+                entry["signal"] = value["signal"]
         else:
             entry["status"] = JobStatus.FAILED.name
             entry["error"] = (value["failed"] if isinstance(value, dict)
@@ -55,6 +60,7 @@ class SweepReport(Callback):
         text = yaml.safe_dump(summary, sort_keys=False, allow_unicode=True)
         (sweep_dir / SUMMARY_FILE).write_text(text)
         FAILED_JOBS[:] = failed
+        STOPPED_JOBS[:] = stopped
         if failed:
             print(f"sim: {len(failed)} of {len(jobs)} jobs failed; see "
                   f"{sweep_dir / SUMMARY_FILE}")

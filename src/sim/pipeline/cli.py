@@ -26,6 +26,7 @@ import atexit
 import contextlib
 import logging
 import os
+import shutil
 import signal
 import sys
 import warnings
@@ -38,8 +39,9 @@ from hydra.types import RunMode
 from omegaconf import OmegaConf
 
 from sim.engine.errors import PhysicsBreakdown
-from sim.pipeline import callbacks, cli_exits, sweep_stop
+from sim.pipeline import callbacks, cli_exits, cluster, sweep_stop
 from sim.pipeline.cli_exits import (
+    EXIT_BAD_CONFIG,
     EXIT_BREAKDOWN,
     EXIT_RUN_FILE,
     fail,
@@ -63,6 +65,7 @@ from sim.pipeline.overrides import (
     SWEEP_FLAGS,
     flags_last,
     hydra_arguments,
+    hydra_settings,
     prints_only,
     value_of,
     whole_numbers,
@@ -95,6 +98,12 @@ def hydra_main(cfg):
     output_dir = HydraConfig.get().runtime.output_dir
     warnings.showwarning = warn_in_one_line  # also in a sweep's workers
     Interruption.sweep_dir = HydraConfig.get().sweep.dir if sweeping else None
+    if sweeping and cluster.in_slurm_job():  # a signal stops this job alone
+        Interruption.time_limit_warning = cluster.TIME_LIMIT_WARNING
+        if sweep_stop.requested(Interruption.sweep_dir) is not None:
+            return {"stopped": Interruption.REASONS[sweep_stop.requested(
+                Interruption.sweep_dir)]}
+        return _job(cfg, sweeping, output_dir)
     if sweeping:
         with sweep_stop.job(Interruption.sweep_dir, stop_at_once):
             asked = sweep_stop.requested(Interruption.sweep_dir)
@@ -135,7 +144,7 @@ def _job(cfg, sweeping, output_dir):
         return {"failed": f"{type(error).__name__}: {error}"}
     except KeyboardInterrupt:
         if sweeping:
-            return _stop_the_sweep(stopped())
+            return _stop_the_sweep(stopped())  # a second signal in a job on a cluster
         where = (f"the run file {path} keeps what was written; continue with: python -m sim "
                  f"resume={path}" if path.exists() else "nothing was written")
         remove_made_folders()
@@ -164,10 +173,22 @@ def _job(cfg, sweeping, output_dir):
     return str(path)
 
 
+def _forget_submission(sweep_dir):
+    """What a sweep the scheduler refused wrote into its folder (submitit's folder, Hydra's
+    multirun.yaml), and the folders this command made, removed: no job ran."""
+    folder = Path(sweep_dir)
+    shutil.rmtree(folder / ".submitit", ignore_errors=True)
+    (folder / "multirun.yaml").unlink(missing_ok=True)
+    remove_made_folders()
+
+
 def _stop_the_sweep(reason):
     """A job a signal stopped (``reason``: interrupted or terminated) stops its whole sweep,
-    and returns so that the launcher waits for the others to end."""
+    and returns so that the launcher waits for the others to end; a job on a cluster stops
+    alone (:mod:`sim.pipeline.cluster`)."""
     signum = signal.SIGTERM if reason == "terminated" else signal.SIGINT
+    if cluster.in_slurm_job():
+        return cluster.stopped_job(Interruption.last_signal or signum)
     sweep_stop.request(HydraConfig.get().sweep.dir, signum)
     return {"stopped": reason}
 
@@ -193,6 +214,12 @@ def main():
         if not prints_only(args):  # --cfg, --info, --hydra-help: no run, no folder
             if sweeping:
                 check_job_folders(args)
+            if sweeping and cluster.slurm_launcher(args):
+                try:
+                    args, asked = cluster.job_resources(args, configs)
+                except ConfigError as error:
+                    fail(str(error))
+                print(asked, file=sys.stderr, flush=True)
             args = run_folder(args)
             check_resources(args, configs)
         if sweeping and value_of(args, "hydra.sweep.dir") is not None:
@@ -218,6 +245,14 @@ def main():
                     leave(f"sim: sweep stopped: a worker process ended ({how}); the same "
                           f"command with hydra.sweep.dir={sweep_dir} continues its jobs",
                           EXIT_RUN_FILE)
+            except Exception as error:  # the scheduler refused the jobs, or lost one
+                if not (sweeping and type(error).__module__.startswith("submitit.")):
+                    raise
+                refused = not any(Path(sweep_dir).rglob(configs[0].output.file))
+                if refused:
+                    _forget_submission(sweep_dir)
+                leave(cluster.scheduler_error(error, sweep_dir),
+                      EXIT_BAD_CONFIG if refused else EXIT_RUN_FILE)
             if sweeping:  # the sweep is over: a late signal must not break the report
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)
@@ -245,6 +280,11 @@ def main():
         sys.exit(stopped_status())  # atexit ends joblib's workers
     if callbacks.FAILED_JOBS:
         sys.exit(EXIT_RUN_FILE)
+    if sweeping and callbacks.STOPPED_JOBS:  # jobs on a cluster, each stopped alone
+        print(cluster.report_stopped(callbacks.STOPPED_JOBS, sweep_dir,
+                                     hydra_settings(args).hydra.launcher.get("timeout_min")),
+              file=sys.stderr)
+        sys.exit(128 + signal.SIGTERM)
     if INTERRUPTED:
         path, reason = INTERRUPTED[0]
         print(f"sim: {reason}; continue with: python -m sim resume={path}", file=sys.stderr)

@@ -1,4 +1,5 @@
-"""SIGINT and SIGTERM as a request to stop a run between compiled chunks."""
+"""SIGINT and SIGTERM (and, in a job on a cluster, the scheduler's warning of its time limit)
+as a request to stop a run between compiled chunks."""
 
 import signal
 import threading
@@ -18,6 +19,11 @@ class Interruption:
     REASONS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
     #: ``f(signal)`` called at a second signal; None: raise KeyboardInterrupt
     at_second_signal = None
+    #: the signal a scheduler sends a job before its time limit, taken as SIGTERM (set in a
+    #: job on a cluster, :mod:`sim.pipeline.cluster`); None elsewhere
+    time_limit_warning = None
+    #: the last signal that asked a run of this process to stop
+    last_signal = None
     #: the folder of the sweep this process runs a job of: its stop file
     #: (:mod:`sim.pipeline.sweep_stop`) asks the run to stop as a signal would; None outside
     #: a sweep
@@ -35,17 +41,19 @@ class Interruption:
 
     @property
     def reason(self):
-        return self.REASONS[self.signal]
+        return self.REASONS.get(self.signal, "terminated")
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
-            for number in self.REASONS:
+            taken = [*self.REASONS, *([self.time_limit_warning]
+                                      if self.time_limit_warning is not None else [])]
+            for number in taken:
                 self._previous[number] = signal.signal(number, self._request)
         return self
 
     def _request(self, signum, frame):
         if self.signal is None:
-            self.signal = signal.Signals(signum)
+            self.signal = Interruption.last_signal = signal.Signals(signum)
         elif Interruption.at_second_signal is not None:
             Interruption.at_second_signal(signal.Signals(signum))
         else:
