@@ -10,6 +10,8 @@
   the site; the rest of ``docs/results/`` is left out of it, its text included into pages.
 - ``api/engine.md``: the table of the effects' Engine keywords (each effect module's
   ``KEYWORDS``), which the Engine's docstring gains only when the module is imported.
+- ``faults-and-clusters.md``: what each job of a sweep on SLURM asks for by default
+  (:func:`sim.pipeline.cluster.resource_table`, from the module's constants).
 - every page: the Sphinx roles of the docstrings (``:class:`Engine` ``) shown as the name.
 """
 
@@ -18,6 +20,7 @@ import importlib
 import io
 import re
 import sys
+import textwrap
 from pathlib import Path
 
 from mkdocs.structure.files import File, InclusionLevel
@@ -30,6 +33,8 @@ FIGURES = ROOT / "outputs" / "figures"
 PUBLISHED = ROOT / "docs" / "results" / "figures"
 #: where api/engine.md shows the effects' keywords
 EFFECT_KEYWORDS = "<!-- effect keywords -->"
+#: where faults-and-clusters.md shows what a job on a cluster asks for (sim.pipeline.cluster)
+CLUSTER_RESOURCES = re.compile(r"^( *)<!-- cluster resources -->", re.M)
 #: number files at most this large are shown as tables in the gallery (bytes)
 LARGEST_TABLE = 4000
 #: the images of docs/results/ that pages show, published although results/ is excluded
@@ -57,8 +62,14 @@ def on_files(files, config):
 
 
 def on_page_markdown(markdown, page, config, files):
-    """The effects' keywords where ``api/engine.md`` asks for them."""
-    return markdown.replace(EFFECT_KEYWORDS, effect_keywords())
+    """The effects' keywords where ``api/engine.md`` asks for them, and what a job on a
+    SLURM cluster asks for by default where ``faults-and-clusters.md`` does (at the
+    indentation of the marker)."""
+    from sim.pipeline.cluster import resource_table
+
+    markdown = markdown.replace(EFFECT_KEYWORDS, effect_keywords())
+    return CLUSTER_RESOURCES.sub(
+        lambda found: textwrap.indent(resource_table(), found.group(1)), markdown)
 
 
 def effect_keywords():

@@ -335,8 +335,9 @@ def test_a_slurm_sweep_asks_for_what_its_runs_need(monkeypatch):
     assert value_of(given, "hydra.launcher.timeout_min") == "30"
     with pytest.raises(ConfigError, match="at most the 60 minutes of partition short"):
         cluster.job_resources([*args[:-1], "hydra.launcher.timeout_min=61", "-m"], configs)
-    assert cluster.job_resources([*args[:-1], "hydra.launcher.partition=long",
-                                  "hydra.launcher.timeout_min=100000", "-m"], configs)
+    long = cluster.job_resources([*args[:-1], "hydra.launcher.partition=long",
+                                  "hydra.launcher.timeout_min=100000", "-m"], configs)[0]
+    assert value_of(long, "hydra.launcher.timeout_min") == "100000"  # no limit there
     with pytest.raises(ConfigError, match="hydra.launcher.partition='gpu'.*: long, short"):
         cluster.job_resources([*args[:-1], "hydra.launcher.partition=gpu", "-m"], configs)
     unbounded = [compose_scene("crater", "stop.collisions=null")]  # to its energy fraction
@@ -347,6 +348,62 @@ def test_a_slurm_sweep_asks_for_what_its_runs_need(monkeypatch):
     assert cluster.minutes("30") == 30 and cluster.minutes("1:30") == 1.5
     assert cluster.minutes("2:00:00") == 120 and cluster.minutes("1-00:00:00") == 1440
     assert cluster.minutes("1-2") == 1560 and cluster.minutes("infinite") is None
+
+
+def test_a_job_on_slurm_is_stopped_alone_and_the_schedulers_words_come_in_one_line(
+        monkeypatch):
+    """sim.pipeline.cluster in a job (its SLURM id from the environment): a signal before the
+    run begins is kept for it (submitit would pass SIGTERM over), the stop recorded with its
+    signal; the sweep's line names the time limit when SLURM's warning or SLURM itself says
+    so; sbatch's refusal in one line naming the setting it speaks of."""
+    import signal
+
+    from omegaconf import OmegaConf
+
+    from sim.pipeline import cluster
+    from sim.pipeline.interruption import Interruption
+
+    monkeypatch.setenv("SLURM_ARRAY_JOB_ID", "41")
+    monkeypatch.setenv("SLURM_ARRAY_TASK_ID", "3")
+    monkeypatch.setenv("SUBMITIT_EXECUTOR", "slurm")
+    assert cluster.slurm_job(OmegaConf.create({"_target_": "x.SlurmLauncher"}))
+    assert not cluster.slurm_job(OmegaConf.create({"_target_": "x.JoblibLauncher"}))
+    handlers = {n: signal.getsignal(n) for n in (signal.SIGTERM, signal.SIGUSR2)}
+    try:
+        cluster.take_signals()
+        assert not Interruption().requested
+        signal.raise_signal(signal.SIGUSR2)  # the time limit's warning while it starts
+        assert Interruption().requested and Interruption().reason == "terminated"
+    finally:
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+        Interruption.early = Interruption.time_limit_warning = None
+        Interruption.at_second_signal = None
+    stopped = cluster.stopped_job(signal.SIGTERM, "terminated")
+    assert stopped == {"stopped": "terminated", "signal": "SIGTERM", "slurm_job": "41_3"}
+    jobs = [{"job": 0, **stopped}, {"job": 1, "signal": "SIGUSR2", "slurm_job": "41_4"}]
+    monkeypatch.setattr(cluster, "scheduler_states", lambda ids: {})
+    line = cluster.report_stopped(jobs, "sweep", 5)
+    assert "jobs 0, 1" in line and "time limit hydra.launcher.timeout_min=5" in line
+    monkeypatch.setattr(cluster, "scheduler_states", lambda ids: {"41_3": "CANCELLED"})
+    assert "cancelled (scancel" in cluster.report_stopped(jobs[:1], "sweep", 5)
+    monkeypatch.setattr(cluster, "scheduler_states", lambda ids: {"41_3": "TIMEOUT"})
+    assert "time limit" in cluster.report_stopped(jobs[:1], "sweep", 5)
+    launcher = OmegaConf.create({"partition": "nosuch", "mem_gb": 900})
+    partition = ("sbatch: error: invalid partition specified: nosuch\n"
+                 "sbatch: error: Batch job submission failed: Invalid partition name specified")
+    assert cluster.refused(partition)
+    assert cluster.scheduler_error(partition, "sweep", launcher) == (
+        "sim: SLURM refused the jobs (hydra.launcher.partition=nosuch): invalid partition "
+        "specified: nosuch; Invalid partition name specified")
+    memory = ("sbatch: error: Memory specification can not be satisfied\n"
+              "sbatch: error: Batch job submission failed: Requested node configuration is "
+              "not available")
+    assert "(hydra.launcher.mem_gb=900): Memory specification" in cluster.scheduler_error(
+        memory, "sweep", launcher)
+    lost = cluster.scheduler_error("Job 41_3 (task: 0) with path x\nhas not produced any "
+                                   "output (state: CANCELLED)", "sweep", launcher)
+    assert lost.startswith("sim: a job of the sweep ended without a result (Job 41_3")
 
 
 def test_the_wall_budget_does_not_count_compiling_the_loop(tmp_path, monkeypatch):

@@ -65,6 +65,7 @@ from tables import extrema, processor_hours, write_markdown, write_tables
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
+from sim.pipeline.config import ConfigError
 from sim.pipeline.resume import resume, stored_config
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
@@ -229,7 +230,11 @@ def _pending(todo):
     for point in todo:
         record = _record(point)
         path = point.folder / "run.h5"
-        stored, reason = stored_config(path) if path.exists() else (None, None)
+        try:
+            stored, reason = stored_config(path) if path.exists() else (None, None)
+        except ConfigError as error:  # a damaged run file: no round until someone looks
+            print(f"melting: {point.folder.name} passed over: {error}", flush=True)
+            continue
         if stored is not None and (record is None or reason in CUT_SHORT):
             # cut short (a signal, a killed job) before the length of its round, which may be
             # its adopted record's: it goes on to that length

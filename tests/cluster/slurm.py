@@ -82,6 +82,7 @@ SlurmctldPidFile={folder / "slurmctld.pid"}
 SlurmdPidFile={folder / "slurmd.pid"}
 SlurmctldLogFile={folder / "slurmctld.log"}
 SlurmdLogFile={folder / "slurmd.log"}
+SlurmdDebug=debug
 ProctrackType=proctrack/pgid
 TaskPlugin=task/none
 SchedulerType=sched/backfill

@@ -81,17 +81,17 @@ def test_a_job_cancelled_goes_on_alone_to_the_bits_of_a_sweep_never_interrupted(
     sweep = tmp_path / "slurm"
     started = sim(*MELTING, *SLURM, folder=sweep, wait=False)
     deadline = time.monotonic() + PATIENCE
-    while not (running := running_jobs()) or not any(sweep.glob("*/run.h5")):
+    while not (begun := [job for job in running_jobs()
+                         if (sweep / job.partition("_")[2] / "run.h5").exists()]):
         assert started.poll() is None and time.monotonic() < deadline, started.communicate()
         time.sleep(0.5)
     time.sleep(2.0)  # well into its run
-    cancelled = running[0]
-    subprocess.run(["scancel", cancelled], check=True)
+    subprocess.run(["scancel", begun[0]], check=True)
     _, stderr = started.communicate(timeout=PATIENCE)
     assert started.returncode == 143, stderr
     lines = said(None, stderr)
     assert lines[0].startswith("sim: each SLURM job asks for")
-    assert "were cancelled" in lines[-1] and f"hydra.sweep.dir={sweep}" in lines[-1]
+    assert "cancelled (scancel" in lines[-1] and f"hydra.sweep.dir={sweep}" in lines[-1]
     summary = (sweep / "sweep_summary.yaml").read_text()
     assert "stopped: 1" in summary and "signal: SIGTERM" in summary
     whole = {p: p.stat().st_mtime_ns for p in sweep.glob("*/run.h5")
@@ -112,6 +112,29 @@ def test_a_job_cancelled_goes_on_alone_to_the_bits_of_a_sweep_never_interrupted(
     assert set(read["stop_reason"].values.ravel()) == {"collisions"}
 
 
+def test_a_job_cancelled_as_it_starts_is_left_unrun_and_the_same_command_runs_it(cluster,
+                                                                                tmp_path):
+    """SIGTERM while the job starts, before its run (submitit would pass it over and SLURM's
+    SIGKILL follow, leaving no result): the job ends stopped at once, and the same command
+    runs it whole."""
+    one = [*MELTING[:2], "disks.packing_fraction=0.70", "stop.collisions=7200000",
+           MELTING[-1]]
+    started = sim(*one, *SLURM, folder=tmp_path, wait=False)
+    deadline = time.monotonic() + PATIENCE
+    while not (tmp_path / "0").exists():  # Hydra made its folder: the job has begun
+        assert started.poll() is None and time.monotonic() < deadline, started.communicate()
+        time.sleep(0.05)
+    subprocess.run(["scancel", running_jobs()[0]], check=True)
+    _, stderr = started.communicate(timeout=PATIENCE)
+    assert started.returncode == 143, stderr
+    assert "cancelled (scancel" in said(None, stderr)[-1]
+    assert "status: STOPPED" in (tmp_path / "0" / "job_status.yaml").read_text()
+    again = sim(*one, *SLURM, folder=tmp_path)
+    assert again.returncode == 0, again.stderr
+    with h5py.File(tmp_path / "0" / "run.h5") as f:
+        assert f["parameters"].attrs["stop_reason"] == "collisions"
+
+
 def test_each_job_asks_what_its_runs_need_and_a_compress_sweep_runs_whole(cluster, tmp_path):
     done = sim(*COMPRESS, *SLURM, folder=tmp_path)
     assert done.returncode == 0, done.stderr
@@ -130,7 +153,8 @@ def test_the_schedulers_refusals_are_one_line_naming_the_setting(cluster, tmp_pa
     for setting, allowed in (("hydra.launcher.partition=nowhere", "a partition of this "
                                                                   "cluster: sim"),
                              ("hydra.launcher.timeout_min=100000", "at most the 1440 "
-                                                                   "minutes of partition sim")):
+                                                                   "minutes of partition sim"),
+                             ("hydra.launcher.mem_gb=100000", "SLURM refused the jobs")):
         refused = sim(*small, *SLURM, setting, folder=tmp_path / "refused")
         assert refused.returncode == 2
         assert said(refused) == [line for line in refused.stderr.splitlines() if line]
@@ -141,7 +165,8 @@ def test_the_schedulers_refusals_are_one_line_naming_the_setting(cluster, tmp_pa
     short = sim(*endless, *SLURM, "hydra.launcher.timeout_min=1", folder=tmp_path / "short")
     assert short.returncode == 143, short.stderr
     assert "reached the time limit hydra.launcher.timeout_min=1" in said(short)[-1]
-    assert "signal: SIGUSR2" in (tmp_path / "short" / "sweep_summary.yaml").read_text()
+    # SLURM's warning before the limit (SIGUSR2), or its SIGTERM at the limit
+    assert "stopped: 2" in (tmp_path / "short" / "sweep_summary.yaml").read_text()
     with h5py.File(next((tmp_path / "short").glob("*/run.h5"))) as f:
         assert f["parameters"].attrs["stop_reason"] == "terminated"
 

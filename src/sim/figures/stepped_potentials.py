@@ -1,17 +1,18 @@
 """Figure 15: disks with a stepped pair potential (:mod:`sim.effects.potential`), the hard core
 σ and shells of constant energy ε_k out to λ_k σ.
 
-(1) The second virial coefficient. A square well (λ = 1.5, ε = −1 in the run's energy
-units, kT = K/(N − 1) with zero total momentum) in a periodic box at four low densities and
-two temperatures, one below the Boyle temperature (kT_B/ε = 1.70: B₂ < 0) and one above
-(B₂ > 0), several seeds each: (βP/ρ − 1)/ρσ² against ρσ², with βPA = N + (N − 1)X/⟨K⟩
-(X the collision virial, steps included, over twice the time), a weighted line taken to
-ρ → 0 and the exact B₂/σ² = (π/2)[1 + (λ² − 1)(1 − e^{βε})] (derived in the docs) at the
-runs' mean kT. The pairs that fall into the well at the start warm the gas, so the runs end
-at somewhat different kT: each run's value is moved to the mean kT by the difference of the
-exact B₂ between the two (:func:`sim.checks.potential.second_virial`, the validation row of
-the same measurement). The first eighth of every run (50 collisions per disk) is cut as its
-equilibration; the error of each density is the standard error over its seeds.
+(1) The second virial coefficient. A square well (λ = 1.5, depth ε = 1 in the run's energy
+units, ε₁ = −ε; kT = K/(N − 1) with zero total momentum) in a periodic box at four low
+densities and two temperatures, one below the Boyle temperature (kT_B/ε = 1.70: B₂ < 0) and
+one above (B₂ > 0), several seeds each: (βP/ρ − 1)/ρσ² against ρσ², with
+βPA = N + (N − 1)X/⟨K⟩ (X the collision virial, steps included, over twice the time), a
+weighted line taken to ρ → 0 and the exact B₂/σ² = (π/2)[1 + (λ² − 1)(1 − e^{βε})] (derived
+in the docs) at the runs' mean kT. The pairs that fall into the well at the start warm the
+gas, so the runs end at somewhat different kT: each run's value is moved to the mean kT by
+the difference of the exact B₂ between the two (:func:`sim.checks.potential.second_virial`,
+the validation row of the same measurement). The first eighth of every run (50 collisions
+per disk) is cut as its equilibration; the error of each density is the standard error over
+its seeds.
 (2) g(r) of a gas with a well inside a shoulder (λ = 1.3, 1.6; ε = −1, +0.5) at φ = 0.2: it
 jumps at every step by e^{−β(u_out − u_in)} (the cavity function is continuous), measured
 by lines fitted to the six bins of 0.01 σ on each side of the step, the error from eight

@@ -5,7 +5,8 @@ end of the sweep ``<sweep dir>/sweep_summary.yaml`` lists them all. A failing jo
 stop the others: in a sweep the job function returns ``{"failed": message}`` instead of
 raising, so the launcher runs every job and the entry point exits with status 1 at the end
 when any failed. A job a signal stopped returns ``{"stopped": reason}``: status STOPPED (on a
-cluster with the signal, ``{"stopped": reason, "signal": name}``).
+cluster with the signal and its SLURM id, ``{"stopped": reason, "signal": name,
+"slurm_job": id}``).
 """
 
 from pathlib import Path
@@ -40,8 +41,8 @@ class SweepReport(Callback):
         elif isinstance(value, dict) and "stopped" in value:  # sim.pipeline.sweep_stop
             entry["status"] = STOPPED
             entry["stop_reason"] = value["stopped"]
-            if "signal" in value:  # a job on a cluster (sim.pipeline.cluster)
-                entry["signal"] = value["signal"]
+            # a job on a cluster: the signal and its SLURM id (sim.pipeline.cluster)
+            entry |= {key: value[key] for key in ("signal", "slurm_job") if key in value}
         else:
             entry["status"] = JobStatus.FAILED.name
             entry["error"] = (value["failed"] if isinstance(value, dict)

@@ -98,12 +98,8 @@ def hydra_main(cfg):
     output_dir = HydraConfig.get().runtime.output_dir
     warnings.showwarning = warn_in_one_line  # also in a sweep's workers
     Interruption.sweep_dir = HydraConfig.get().sweep.dir if sweeping else None
-    if sweeping and cluster.in_slurm_job():  # a signal stops this job alone
-        Interruption.time_limit_warning = cluster.TIME_LIMIT_WARNING
-        if sweep_stop.requested(Interruption.sweep_dir) is not None:
-            return {"stopped": Interruption.REASONS[sweep_stop.requested(
-                Interruption.sweep_dir)]}
-        return _job(cfg, sweeping, output_dir)
+    if sweeping and cluster.slurm_job(HydraConfig.get().launcher):
+        return _cluster_job(cfg, output_dir)
     if sweeping:
         with sweep_stop.job(Interruption.sweep_dir, stop_at_once):
             asked = sweep_stop.requested(Interruption.sweep_dir)
@@ -117,8 +113,21 @@ def hydra_main(cfg):
     return _job(cfg, sweeping, output_dir)
 
 
-def _job(cfg, sweeping, output_dir):
-    """:func:`hydra_main`'s job, in its folder ``output_dir``."""
+def _cluster_job(cfg, output_dir):
+    """A job of a sweep on a SLURM cluster, in its folder ``output_dir``: a signal stops it
+    alone (:mod:`sim.pipeline.cluster`); one that came before its run began, nothing run."""
+    cluster.take_signals()
+    asked = sweep_stop.requested(Interruption.sweep_dir)
+    if asked is not None:  # the sweep was stopped (Ctrl-C to its command) before this job
+        return {"stopped": Interruption.REASONS[asked]}
+    if Interruption.early is not None:  # cancelled while it started
+        return cluster.stopped_job(Interruption.early, "terminated")
+    return _job(cfg, True, output_dir, alone=True)
+
+
+def _job(cfg, sweeping, output_dir, alone=False):
+    """:func:`hydra_main`'s job, in its folder ``output_dir``; ``alone``: a job on a
+    cluster, which a signal stops without its sweep."""
     overrides = list(HydraConfig.get().overrides.task)
     path = Path(cfg.resume) if cfg.resume is not None else Path(output_dir) / cfg.output.file
     try:
@@ -144,7 +153,7 @@ def _job(cfg, sweeping, output_dir):
         return {"failed": f"{type(error).__name__}: {error}"}
     except KeyboardInterrupt:
         if sweeping:
-            return _stop_the_sweep(stopped())  # a second signal in a job on a cluster
+            return _stop_the_sweep(stopped(), alone)
         where = (f"the run file {path} keeps what was written; continue with: python -m sim "
                  f"resume={path}" if path.exists() else "nothing was written")
         remove_made_folders()
@@ -168,27 +177,29 @@ def _job(cfg, sweeping, output_dir):
           f"run file: {path}", flush=True)
     if info["stop_reason"] in ("interrupted", "terminated"):
         if sweeping:
-            return _stop_the_sweep(info["stop_reason"])
+            return _stop_the_sweep(info["stop_reason"], alone)
         INTERRUPTED.append((path, info["stop_reason"]))
     return str(path)
 
 
 def _forget_submission(sweep_dir):
-    """What a sweep the scheduler refused wrote into its folder (submitit's folder, Hydra's
-    multirun.yaml), and the folders this command made, removed: no job ran."""
-    folder = Path(sweep_dir)
-    shutil.rmtree(folder / ".submitit", ignore_errors=True)
-    (folder / "multirun.yaml").unlink(missing_ok=True)
+    """A sweep folder this command made, whose jobs SLURM refused (none was queued): what
+    was written into it (submitit's folder, Hydra's multirun.yaml) removed with it. A folder
+    of an earlier sweep keeps its files."""
+    folder = Path(sweep_dir).resolve()
+    if folder in {made.resolve() for made in cli_exits.MADE_FOLDERS}:
+        shutil.rmtree(folder / ".submitit", ignore_errors=True)
+        (folder / "multirun.yaml").unlink(missing_ok=True)
     remove_made_folders()
 
 
-def _stop_the_sweep(reason):
+def _stop_the_sweep(reason, alone=False):
     """A job a signal stopped (``reason``: interrupted or terminated) stops its whole sweep,
-    and returns so that the launcher waits for the others to end; a job on a cluster stops
-    alone (:mod:`sim.pipeline.cluster`)."""
+    and returns so that the launcher waits for the others to end; a job on a cluster
+    (``alone``) stops without it (:mod:`sim.pipeline.cluster`)."""
     signum = signal.SIGTERM if reason == "terminated" else signal.SIGINT
-    if cluster.in_slurm_job():
-        return cluster.stopped_job(Interruption.last_signal or signum)
+    if alone:
+        return cluster.stopped_job(Interruption.last_signal or signum, reason)
     sweep_stop.request(HydraConfig.get().sweep.dir, signum)
     return {"stopped": reason}
 
@@ -245,14 +256,15 @@ def main():
                     leave(f"sim: sweep stopped: a worker process ended ({how}); the same "
                           f"command with hydra.sweep.dir={sweep_dir} continues its jobs",
                           EXIT_RUN_FILE)
-            except Exception as error:  # the scheduler refused the jobs, or lost one
-                if not (sweeping and type(error).__module__.startswith("submitit.")):
+            except Exception as error:  # SLURM refused the jobs, or lost one
+                if not (sweeping and cluster.slurm_launcher(args)
+                        and type(error).__module__.startswith("submitit.")):
                     raise
-                refused = not any(Path(sweep_dir).rglob(configs[0].output.file))
-                if refused:
+                if cluster.refused(error):
                     _forget_submission(sweep_dir)
-                leave(cluster.scheduler_error(error, sweep_dir),
-                      EXIT_BAD_CONFIG if refused else EXIT_RUN_FILE)
+                leave(cluster.scheduler_error(error, sweep_dir,
+                                              hydra_settings(args).hydra.launcher),
+                      EXIT_BAD_CONFIG if cluster.refused(error) else EXIT_RUN_FILE)
             if sweeping:  # the sweep is over: a late signal must not break the report
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)
@@ -280,7 +292,7 @@ def main():
         sys.exit(stopped_status())  # atexit ends joblib's workers
     if callbacks.FAILED_JOBS:
         sys.exit(EXIT_RUN_FILE)
-    if sweeping and callbacks.STOPPED_JOBS:  # jobs on a cluster, each stopped alone
+    if sweeping and callbacks.STOPPED_JOBS and cluster.slurm_launcher(args):  # each alone
         print(cluster.report_stopped(callbacks.STOPPED_JOBS, sweep_dir,
                                      hydra_settings(args).hydra.launcher.get("timeout_min")),
               file=sys.stderr)

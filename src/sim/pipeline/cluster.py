@@ -11,10 +11,12 @@ them and ``hydra.launcher.partition`` against the cluster's partitions (``sinfo`
 partition that does not exist, or a time limit beyond the partition's, is one line naming the
 setting and exit status 2, before anything is written.
 
-In a job on the cluster (:func:`in_slurm_job`), a signal stops that job alone, not the
-sweep: ``scancel`` (SIGTERM) and the warning submitit asks SLURM to send
-``signal_delay_s`` seconds before the time limit (SIGUSR2) end the run with its final
-snapshot and checkpoint, stop reason ``terminated``, and the job's status records the signal.
+In a job on the cluster (:func:`slurm_job`, :func:`take_signals`), a signal stops that job
+alone, not the sweep: ``scancel`` (SIGTERM), the warning submitit asks SLURM to send
+``signal_delay_s`` seconds before the time limit (:func:`time_limit_warning`) and SLURM's
+SIGTERM at the limit end the run with its final snapshot and checkpoint, stop reason
+``terminated``, and the job's status records the signal and its SLURM id; one that comes
+while the job starts, before its run, leaves it unrun.
 The sweep's process reports such jobs at the end in one line (:func:`report_stopped`), and
 the same command continues them; the scheduler's refusals and jobs that ended without a
 result reach the user as one line too (:func:`scheduler_error`).
@@ -29,6 +31,7 @@ import subprocess
 
 from sim.pipeline import resources
 from sim.pipeline.config import ConfigError
+from sim.pipeline.interruption import Interruption
 from sim.pipeline.overrides import hydra_settings, value_of, with_value
 
 #: collisions per second a run is assumed to make on a cluster's core (a slow core: this
@@ -38,13 +41,37 @@ ASSUMED_RATE = 1e6
 START_MINUTES = 5
 #: the memory asked of the scheduler over the estimate
 MEMORY_MARGIN = 1.25
-#: the signal SLURM sends (through submitit's ``--signal``) before a job's time limit
-TIME_LIMIT_WARNING = signal.SIGUSR2
+#: what SLURM's refusals speak of, and the launcher's setting for it
+REFUSED_SETTINGS = (("partition", "partition"), ("time limit", "timeout_min"),
+                    ("memory", "mem_gb"), ("account", "account"), ("qos", "qos"))
 
 
-def in_slurm_job():
-    """Whether this process runs a job that submitit started on SLURM."""
-    return os.environ.get("SUBMITIT_EXECUTOR") == "slurm"
+def time_limit_warning():
+    """The signal SLURM sends a job (submitit's ``--signal``) before its time limit:
+    ``SUBMITIT_PREEMPT_SIGNAL``, by default SIGUSR2."""
+    return signal.Signals["SIG" + os.environ.get("SUBMITIT_PREEMPT_SIGNAL", "USR2")]
+
+
+def slurm_job(launcher):
+    """Whether this process runs a job that submitit started on SLURM for a sweep whose
+    launcher config is ``launcher``."""
+    return (os.environ.get("SUBMITIT_EXECUTOR") == "slurm"
+            and str(launcher.get("_target_", "")).endswith("SlurmLauncher"))
+
+
+def _ignored(signum):
+    """A repeated signal to a job on the cluster: its run stops already, SIGKILL follows."""
+
+
+def take_signals():
+    """In a job on the cluster, from its start: SIGTERM and the time-limit warning stop this
+    job's run (:meth:`sim.pipeline.interruption.Interruption.take_early` until it begins,
+    then the run's own handler), not the sweep; a repeated one is passed over."""
+    Interruption.time_limit_warning = time_limit_warning()
+    Interruption.early = Interruption.last_signal = None
+    Interruption.at_second_signal = _ignored
+    for number in (signal.SIGTERM, Interruption.time_limit_warning):
+        signal.signal(number, Interruption.take_early)
 
 
 def slurm_launcher(args):
@@ -142,30 +169,87 @@ def job_resources(args, configs):
                   f"partition {partition or 'the default'}")
 
 
-def stopped_job(signum):
-    """The status a job on the cluster records when ``signum`` stopped it."""
-    return {"stopped": "terminated", "signal": signal.Signals(signum).name}
+def stopped_job(signum, reason):
+    """The status a job on the cluster records when ``signum`` stopped its run with stop
+    reason ``reason``: the signal and the job's SLURM id (``<array>_<task>`` in an array)."""
+    env = os.environ
+    task = env.get("SLURM_ARRAY_TASK_ID")
+    slurm_id = (f"{env['SLURM_ARRAY_JOB_ID']}_{task}" if task is not None
+                else env.get("SLURM_JOB_ID", ""))
+    return {"stopped": reason, "signal": signal.Signals(signum).name, "slurm_job": slurm_id}
+
+
+def _answer(command):
+    try:
+        return subprocess.run(command, capture_output=True, text=True, timeout=60).stdout
+    except (subprocess.SubprocessError, OSError):
+        return ""
+
+
+def scheduler_states(slurm_ids):
+    """{SLURM id: state} (``TIMEOUT``, ``CANCELLED`` …) of the jobs ``slurm_ids`` from the
+    cluster's accounting (one ``sacct``) or, without it, from the controller (``scontrol``,
+    which keeps an ended job for ``MinJobAge`` seconds); a job neither knows is left out."""
+    listed = _answer(["sacct", "--noheader", "--allocations", "--parsable2",
+                      "--format=JobID,State", "--jobs", ",".join(slurm_ids)])
+    states = {}
+    for line in listed.splitlines():
+        slurm_id, _, state = line.partition("|")
+        if slurm_id in slurm_ids and state:
+            states[slurm_id] = state.split()[0]
+    for slurm_id in set(slurm_ids) - set(states):
+        if found := re.search(r"JobState=(\w+)", _answer(["scontrol", "show", "job", slurm_id])):
+            states[slurm_id] = found.group(1)
+    return states
 
 
 def report_stopped(stopped, sweep_dir, timeout):
     """One line on the jobs of a SLURM sweep that a signal stopped (``stopped``: their
-    status entries), naming the time limit when it was the cause."""
+    status entries), naming the time limit when it was the cause: the warning before it
+    came, or SLURM says so."""
     numbers = ", ".join(str(job["job"]) for job in stopped)
-    limit = [job for job in stopped if job.get("signal") == TIME_LIMIT_WARNING.name]
+    states = scheduler_states([job["slurm_job"] for job in stopped if job.get("slurm_job")])
+    limit = [job for job in stopped if job.get("signal") == time_limit_warning().name
+             or states.get(job.get("slurm_job")) == "TIMEOUT"]
+    one = len(stopped) == 1
     cause = (f"reached the time limit hydra.launcher.timeout_min={timeout}" if limit
-             else "were cancelled (scancel, or the scheduler)")
-    return (f"sim: jobs {numbers} of the sweep {cause}; their run files keep what was written, "
-            f"and the same command with hydra.sweep.dir={sweep_dir} continues them"
+             else f"{'was' if one else 'were'} cancelled (scancel, or the scheduler)")
+    return (f"sim: {'job' if one else 'jobs'} {numbers} of the sweep {cause}; what they "
+            f"wrote is kept, and the same command with hydra.sweep.dir={sweep_dir} continues "
+            f"them"
             + (" (with a longer hydra.launcher.timeout_min)" if limit else ""))
 
 
-def scheduler_error(error, sweep_dir):
-    """One line for an error of submitit: the scheduler refused the jobs (its message), or
-    a job ended without a result (killed by the scheduler, a node lost)."""
-    text = " ".join(str(error).split())
-    match = re.search(r"sbatch: error: ([^:]*: )?(.*?)(sbatch: error|$)", text)
-    if match:
-        return f"sim: SLURM refused the jobs: {match.group(2).strip()}"
+def refused(error):
+    """Whether submitit's ``error`` is SLURM refusing the jobs (``sbatch`` failed): nothing
+    was queued."""
+    return "Batch job submission failed" in str(error)
+
+
+def scheduler_error(error, sweep_dir, launcher):
+    """One line for an error of submitit: the scheduler refused the jobs (its messages, and
+    the launcher's setting they speak of, from the launcher config ``launcher``), or a job
+    ended without a result (killed by the scheduler, a node lost)."""
+    if refused(error):
+        said = [line.split("sbatch: error:", 1)[1].strip() for line in str(error).splitlines()
+                if "sbatch: error:" in line]
+        text = "; ".join(part.replace("Batch job submission failed: ", "") for part in said)
+        setting = next((f" (hydra.launcher.{key}={launcher.get(key)})"
+                        for word, key in REFUSED_SETTINGS if word in text.lower()), "")
+        return f"sim: SLURM refused the jobs{setting}: {text}"
     first = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
     return (f"sim: a job of the sweep ended without a result ({first}); the same command "
             f"with hydra.sweep.dir={sweep_dir} continues its jobs")
+
+
+def resource_table():
+    """The Markdown table of what each job asks of the scheduler by default (the docs'
+    cluster page)."""
+    return "\n".join([
+        "| setting | from |", "| --- | --- |",
+        f"| `hydra.launcher.mem_gb` | the largest run's memory estimate × {MEMORY_MARGIN:g} |",
+        f"| `hydra.launcher.timeout_min` | twice the longest run's `stop.collisions` (or "
+        f"`stop.contacts`) at {ASSUMED_RATE:.0e} collisions per second, or its "
+        f"`stop.wall_seconds`, and {START_MINUTES} minutes for its start; runs that none of "
+        f"them bounds (a crater to its energy fraction) keep the launcher's value |",
+        "| `hydra.launcher.partition` | the cluster's default partition |"])

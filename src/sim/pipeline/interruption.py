@@ -24,6 +24,9 @@ class Interruption:
     time_limit_warning = None
     #: the last signal that asked a run of this process to stop
     last_signal = None
+    #: a signal that came to a job on a cluster before its run began (:meth:`take_early`):
+    #: the run stops at its first chunk
+    early = None
     #: the folder of the sweep this process runs a job of: its stop file
     #: (:mod:`sim.pipeline.sweep_stop`) asks the run to stop as a signal would; None outside
     #: a sweep
@@ -33,8 +36,16 @@ class Interruption:
         self.signal = None
         self._previous = {}
 
+    @staticmethod
+    def take_early(signum, frame):
+        """The handler of a job on a cluster until its run begins (submitit's would pass
+        SIGTERM over, and SLURM's SIGKILL would follow): the run stops at once."""
+        Interruption.early = Interruption.last_signal = signal.Signals(signum)
+
     @property
     def requested(self):
+        if self.signal is None:
+            self.signal = Interruption.early
         if self.signal is None and Interruption.sweep_dir is not None:
             self.signal = sweep_stop.requested(Interruption.sweep_dir)
         return self.signal is not None
