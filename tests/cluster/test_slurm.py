@@ -153,14 +153,19 @@ def test_the_schedulers_refusals_are_one_line_naming_the_setting(cluster, tmp_pa
     for setting, allowed in (("hydra.launcher.partition=nowhere", "a partition of this "
                                                                   "cluster: sim"),
                              ("hydra.launcher.timeout_min=100000", "at most the 1440 "
-                                                                   "minutes of partition sim"),
-                             ("hydra.launcher.mem_gb=100000", "SLURM refused the jobs")):
+                                                                   "minutes of partition sim")):
         refused = sim(*small, *SLURM, setting, folder=tmp_path / "refused")
         assert refused.returncode == 2
         assert said(refused) == [line for line in refused.stderr.splitlines() if line]
         assert len(said(refused)) == 1 and setting.split("=")[0] in said(refused)[0]
         assert allowed in said(refused)[0]
         assert not (tmp_path / "refused").exists()
+    # memory no node has: sbatch refuses (its own lines come first, as submitit prints them)
+    memory = sim(*small, *SLURM, "hydra.launcher.mem_gb=100000", folder=tmp_path / "memory")
+    assert memory.returncode == 2
+    assert said(memory)[-1].startswith("sim: SLURM refused the jobs (hydra.launcher.mem_gb="
+                                       "100000): Memory specification can not be satisfied")
+    assert not (tmp_path / "memory").exists()
     endless = [*MELTING[:-2], "stop.collisions=1000000000"]  # far beyond a minute
     short = sim(*endless, *SLURM, "hydra.launcher.timeout_min=1", folder=tmp_path / "short")
     assert short.returncode == 143, short.stderr
