@@ -249,7 +249,7 @@ def resource_table():
         "| setting | from |", "| --- | --- |",
         f"| `hydra.launcher.mem_gb` | the largest run's memory estimate × {MEMORY_MARGIN:g} |",
         f"| `hydra.launcher.timeout_min` | twice the longest run's `stop.collisions` (or "
-        f"`stop.contacts`) at {ASSUMED_RATE:.0e} collisions per second, or its "
+        f"`stop.contacts`) at {ASSUMED_RATE:,.0f} collisions per second, or its "
         f"`stop.wall_seconds`, and {START_MINUTES} minutes for its start; runs that none of "
         f"them bounds (a crater to its energy fraction) keep the launcher's value |",
         "| `hydra.launcher.partition` | the cluster's default partition |"])
