@@ -12,6 +12,7 @@ energy, kT = ⟨K⟩/(N − 1) with zero total momentum, K = Σ m v²/2 in two d
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -80,23 +81,36 @@ def step_jumps(n=1000, phi=0.2, temperature=1.0, steps=(1.3, 1.6), energies=(-1.
         engine.run(collisions=engine.collisions + n)
         g[s // per_block] += g_of(engine, engine.time, engine.positions(), None) / per_block
         kinetic.append(engine.kinetic_energy())
-    beta = (n - 1) / float(np.mean(kinetic))
-    centres = g_of.coords["r"]
+    kt = float(np.mean(kinetic)) / (n - 1)
     u = np.concatenate([[0.0], energies, [0.0]])
     rows = []
-    for k, step in enumerate(steps):
-        at = int(round(step / width))  # the edge index of the step
-        inside, outside = slice(at - fitted, at), slice(at, at + fitted)
-        ratios = [np.polyval(np.polyfit(centres[outside], gb[outside], 1), step)
-                  / np.polyval(np.polyfit(centres[inside], gb[inside], 1), step) for gb in g]
-        mean, error = block_means(ratios)
-        expected = math.exp(-beta * (u[k + 2] - u[k + 1]))
+    for k, (step, mean, error, expected) in enumerate(
+            step_ratios(g_of.coords["r"], g, steps, energies, kt, fitted)):
         rows.append(Check(
             f"g(λσ⁺)/g(λσ⁻) at λ = {step} (u {u[k + 1]:g} → {u[k + 2]:g}), kT/ε = "
-            f"{1 / beta:.3f}, φ = {phi}, N = {n}, {snapshots} snapshots", mean, expected,
+            f"{kt:.3f}, φ = {phi}, N = {n}, {snapshots} snapshots", mean, expected,
             4.0 * error, "continuity of the cavity function: e^{−β(u_out − u_in)}",
             time.perf_counter() - started if not rows else None))
     return rows
+
+
+def step_ratios(r, blocks, steps, energies, kt, fitted):
+    """g(λσ⁺)/g(λσ⁻) at every step ``steps`` (units of σ) with its standard error over
+    ``blocks`` (float64[blocks, bins], g in bins centred at ``r``, σ units, whose edges sit
+    on the steps), each side a line through its ``fitted`` bins taken to the step; and
+    e^{−(u_out − u_in)/kT} of the potential's ``energies``. A list of (λ, ratio, error,
+    expected)."""
+    width = r[1] - r[0]
+    u = np.concatenate([[0.0], energies, [0.0]])
+    found = []
+    for k, step in enumerate(steps):
+        at = int(round(step / width))  # the bin edge on the step
+        inside, outside = slice(at - fitted, at), slice(at, at + fitted)
+        ratios = [np.polyval(np.polyfit(r[outside], g[outside], 1), step)
+                  / np.polyval(np.polyfit(r[inside], g[inside], 1), step) for g in blocks]
+        mean, error = block_means(ratios)
+        found.append((step, mean, error, math.exp(-(u[k + 2] - u[k + 1]) / kt)))
+    return found
 
 
 def second_virial_coefficient(temperature, steps, energies):
@@ -166,22 +180,41 @@ def second_virial(n=1000, phis=(0.01, 0.02, 0.03, 0.04), temperatures=(1.0, 3.0)
                 rho = n * (2.0 * radius) ** 2  # ρσ² in the unit box
                 kt = float(np.mean(kinetic)) / (n - 1)
                 runs.append((rho, (n - 1) * x / (n * float(np.mean(kinetic))) / rho, kt))
-        rho, ratio, kts = (np.array(column) for column in zip(*runs, strict=True))
-        kt = float(np.mean(kts))
-        ratio = ratio - np.array([second_virial_coefficient(t, steps, energies) for t in kts]) \
-            + second_virial_coefficient(kt, steps, energies)
-        density, means, errors = [], [], []
-        for value in np.unique(rho):
-            mean, error = block_means(ratio[rho == value])
-            density.append(value)
-            means.append(mean)
-            errors.append(error)
-        (slope, intercept), cov = np.polyfit(density, means, 1, w=1.0 / np.asarray(errors),
-                                             cov="unscaled")
+        found = extrapolated_b2(runs, steps, energies)
         rows.append(Check(
             f"B₂/σ² of a square well λ = {steps[0]}, ε = {-energies[0]:g}, from βP/ρ at "
             f"φ = {', '.join(f'{p:g}' for p in phis)} ({replicas} runs each) to ρ → 0, "
-            f"kT/ε = {kt:.3f}, N = {n}", float(intercept),
-            second_virial_coefficient(kt, steps, energies), 4.0 * math.sqrt(cov[1, 1]),
+            f"kT/ε = {found.kt:.3f}, N = {n}", found.b2, found.exact, 4.0 * found.b2_error,
             "B₂ = (πσ²/2)[1 + (λ² − 1)(1 − e^{βε})], exact", time.perf_counter() - started))
     return rows
+
+
+class Virial(NamedTuple):
+    """B₂ from runs at one temperature (:func:`extrapolated_b2`)."""
+    kt: float  # the runs' mean kT
+    density: np.ndarray  # ρσ² of each packing fraction
+    mean: np.ndarray  # (βP/ρ − 1)/ρσ² at each, over its runs
+    error: np.ndarray  # its standard error
+    b2: float  # B₂/σ², the weighted line's intercept
+    b2_error: float
+    slope: float
+    exact: float  # B₂/σ² at kT (:func:`second_virial_coefficient`)
+    runs: int
+
+
+def extrapolated_b2(runs, steps, energies):
+    """The :class:`Virial` of ``runs``, (ρσ², (βP/ρ − 1)/ρσ², kT) of each: every run's
+    value moved to the runs' mean kT by the difference of the exact B₂ between the two, the
+    mean and standard error of each density's runs, and a line weighted by them taken to
+    ρ → 0."""
+    rho, ratio, kts = (np.array(column) for column in zip(*runs, strict=True))
+    kt = float(np.mean(kts))
+    exact = second_virial_coefficient(kt, steps, energies)
+    ratio = ratio - np.array([second_virial_coefficient(t, steps, energies) for t in kts]) \
+        + exact
+    densities = np.unique(rho)
+    means, errors = (np.array(c) for c in zip(*(block_means(ratio[rho == d])
+                                                 for d in densities), strict=True))
+    (slope, intercept), cov = np.polyfit(densities, means, 1, w=1.0 / errors, cov="unscaled")
+    return Virial(kt, densities, means, errors, float(intercept), math.sqrt(cov[1, 1]),
+                  float(slope), exact, rho.size)

@@ -23,16 +23,12 @@ critical point: the gas splits into liquid drops and vapour, the disks coloured 
 others sit inside their well (the movie of the same run is ``movie_square_well``).
 """
 
-import math
-from typing import NamedTuple
-
 import numpy as np
 import yaml
 from scipy.spatial import cKDTree
 
 from sim.analysis.datasets import open_run, open_sweep
-from sim.checks.potential import second_virial_coefficient
-from sim.checks.rows import block_means
+from sim.checks.potential import extrapolated_b2, step_ratios
 from sim.figures.style import draw_disks, figure, save
 
 NAME = "fig15_stepped_potentials"
@@ -115,61 +111,24 @@ def _virial_ratio(run):
     return rho, (n - 1) * x / (n * mean_kinetic) / rho, mean_kinetic / (n - 1)
 
 
-class Virial(NamedTuple):
-    """B₂ from the runs at one temperature."""
-    kt: float  # the runs' mean kT
-    density: np.ndarray  # ρσ² of each packing fraction
-    mean: np.ndarray  # (βP/ρ − 1)/ρσ² at each, over the seeds
-    error: np.ndarray  # its standard error
-    b2: float  # B₂/σ², the weighted line's intercept
-    b2_error: float
-    slope: float
-    exact: float  # B₂/σ² at kT
-    runs: int
-
-
 def _second_virial(sweep):
-    """A :class:`Virial` per temperature of the sweep."""
-    rows = []
-    for temperature in sweep["disks_temperature"].values:
-        runs = [_virial_ratio(sweep.sel(disks_temperature=temperature, disks_packing_fraction=phi,
-                                        seed=seed))
-                for phi in sweep["disks_packing_fraction"].values
-                for seed in sweep["seed"].values]
-        rho, ratio, kts = (np.array(column) for column in zip(*runs, strict=True))
-        kt = float(np.mean(kts))
-        ratio = ratio - np.array([second_virial_coefficient(t, [WELL], [WELL_ENERGY])
-                                  for t in kts]) \
-            + second_virial_coefficient(kt, [WELL], [WELL_ENERGY])
-        densities = np.unique(rho)
-        means, errors = zip(*(block_means(ratio[rho == d]) for d in densities), strict=True)
-        (slope, intercept), cov = np.polyfit(densities, means, 1, w=1.0 / np.asarray(errors),
-                                             cov="unscaled")
-        rows.append(Virial(kt, densities, np.array(means), np.array(errors), float(intercept),
-                           math.sqrt(cov[1, 1]), float(slope),
-                           second_virial_coefficient(kt, [WELL], [WELL_ENERGY]), rho.size))
-    return rows
+    """A :class:`sim.checks.potential.Virial` per temperature of the sweep."""
+    return [extrapolated_b2([_virial_ratio(sweep.sel(disks_temperature=temperature,
+                                                     disks_packing_fraction=phi, seed=seed))
+                             for phi in sweep["disks_packing_fraction"].values
+                             for seed in sweep["seed"].values], [WELL], [WELL_ENERGY])
+            for temperature in sweep["disks_temperature"].values]
 
 
 def _jumps(run):
-    """(r/σ, g, kT, [(λ, measured ratio, error, e^{−β(u_out − u_in)})]) over the production."""
+    """(r/σ, g, kT, [(λ, measured ratio, error, e^{−β(u_out − u_in)})]) over the production
+    (:func:`sim.checks.potential.step_ratios`)."""
     kept = _production(run)
     g = run["radial_distribution"].values[kept]
-    n = run.sizes["disk"]
-    kt = float(np.mean(run["kinetic_energy"].values[kept])) / (n - 1)
+    kt = float(np.mean(run["kinetic_energy"].values[kept])) / (run.sizes["disk"] - 1)
     r = run["r"].values
-    width = r[1] - r[0]
     blocks = np.array([block.mean(axis=0) for block in np.array_split(g, BLOCKS)])
-    u = np.concatenate([[0.0], ENERGIES, [0.0]])
-    found = []
-    for k, step in enumerate(STEPS):
-        at = int(round(step / width))  # the bin edge on the step
-        inside, outside = slice(at - FITTED, at), slice(at, at + FITTED)
-        ratios = [np.polyval(np.polyfit(r[outside], gb[outside], 1), step)
-                  / np.polyval(np.polyfit(r[inside], gb[inside], 1), step) for gb in blocks]
-        mean, error = block_means(ratios)
-        found.append((step, mean, error, math.exp(-(u[k + 2] - u[k + 1]) / kt)))
-    return r, g.mean(axis=0), kt, found
+    return r, g.mean(axis=0), kt, step_ratios(r, blocks, STEPS, ENERGIES, kt, FITTED)
 
 
 def _wells_filled(position, radius, reach):
