@@ -139,9 +139,11 @@ def _wells_filled(position, radius, reach):
 
 
 def draw(runs, sweeps, out_dir):
-    virial = _second_virial(open_sweep(sweeps["virial"]))
+    sweep = open_sweep(sweeps["virial"])
+    virial, seeds = _second_virial(sweep), sweep["seed"].values
     with open_run(runs["jumps"]) as run:
         r, g, kt_jumps, jumps = _jumps(run.load())
+        seed_jumps, n_jumps = int(run.attrs["seed"]), run.sizes["disk"]
     with open_run(runs["square_well"]) as run:
         position = run["position"].values[-1]
         radius = run["radius"].values
@@ -150,6 +152,7 @@ def draw(runs, sweeps, out_dir):
         n = run.sizes["disk"]
         kt_split = float(run["kinetic_energy"].values[-1]) / n  # K = N kT between walls
         collisions = int(run["collisions"].values[-1])
+        seed_split = int(run.attrs["seed"])
     reach, walls = config["potential"]["steps"][-1], config["walls"]["left"]["temperature"]
     fig, (left, middle, right) = figure(ncols=3, width=16, height=4.8)
     line = np.linspace(0.0, max(v.density.max() for v in virial) * 1.05, 50)
@@ -161,7 +164,9 @@ def draw(runs, sweeps, out_dir):
                   label=f"exact B₂/σ² = {v.exact:.3f}")
     left.axhline(0.0, color="0.6", lw=0.8)
     left.set(xlabel="ρσ²", ylabel="(βP/ρ − 1)/ρσ²",
-             title=f"square well λ = {WELL}: to ρ → 0 ({virial[0].runs} runs per kT)")
+             title=f"square well λ = {WELL}: to ρ → 0 ({virial[0].runs} runs per kT,\n"
+                   f"N = {sweep.sizes['disk']}, seeds {seeds.min()}–{seeds.max()}; "
+                   f"± standard error over the seeds)")
     left.legend(fontsize=7)
     middle.plot(r, g, color="C0", lw=1, drawstyle="steps-mid")
     for step, ratio, error, expected in jumps:
@@ -170,14 +175,15 @@ def draw(runs, sweeps, out_dir):
                         (step, 0.95 * g.max()), fontsize=7, ha="left")
     middle.set(xlim=(0.9, R_MAX), xlabel="r/σ", ylabel="g(r)",
                title=f"well ε = {ENERGIES[0]:g} to {STEPS[0]}σ, shoulder {ENERGIES[1]:g} to "
-                     f"{STEPS[1]}σ; kT/ε = {kt_jumps:.3f}")
+                     f"{STEPS[1]}σ; kT/ε = {kt_jumps:.3f}\nN = {n_jumps}, seed {seed_jumps}; "
+                     f"± standard error over {BLOCKS} blocks")
     filled = _wells_filled(position, radius, reach)
     disks = draw_disks(right, position, radius, values=filled.astype(float), cmap="viridis")
     fig.colorbar(disks, ax=right, label=f"disks within {reach}σ")
     right.grid(False)
     right.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[],
               title=f"square well, walls at kT/ε = {walls}: {n} disks, {collisions:.2g} "
-                    f"collisions\n(kinetic kT/ε = {kt_split:.2f} at the end)")
+                    f"collisions\n(kinetic kT/ε = {kt_split:.2f} at the end), seed {seed_split}")
     np.savetxt(out_dir / f"{NAME}.csv",
                [(v.kt, v.b2, v.b2_error, v.exact, v.slope, v.runs) for v in virial],
                delimiter=",", header="kT,B2,B2_error,B2_exact,slope,runs", comments="")
