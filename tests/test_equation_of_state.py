@@ -77,7 +77,8 @@ def test_the_equilibration_cut_drops_a_drift_and_keeps_a_stationary_series():
 
 def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
     """A short melting run: one block per snapshot interval, the formula's value from the
-    run file's virial and time, and a run that does not start at zero momentum refused."""
+    run file's virial and time; a run whose kinetic energy changes beyond round-off and one
+    that does not start at zero momentum refused."""
     from sim.analysis.datasets import open_run
     from sim.analysis.theory import kolafa_rottner_z
     from sim.pipeline.run_cache import compose_config
@@ -99,6 +100,15 @@ def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
         assert point.cut + point.blocks == 40
         z = kolafa_rottner_z(0.6)  # βP/ρ, and ρ d² = 4φ/π
         assert point.mean == pytest.approx(z * 4.0 * 0.6 / math.pi, rel=0.02)
+        # round-off's drift of K over a long run is passed; a dissipative run's is not
+        ramp = np.linspace(0.0, 1.0, data.sizes["time"])
+        for change, refused in ((1e-8, False), (1e-5, True)):
+            changed = data.assign(kinetic_energy=data["kinetic_energy"] * (1.0 + change * ramp))
+            if refused:
+                with pytest.raises(ValueError, match="an elastic run.*changes by 1.0e-05"):
+                    block_pressures(changed)
+            else:
+                assert np.allclose(block_pressures(changed)[0], pressure, rtol=1e-7)
     drifting = run(compose_config([*overrides, "disks.zero_momentum=false"]), tmp_path / "b")
     with open_run(drifting) as data, pytest.raises(ValueError, match="total momentum"):
         block_pressures(data)
