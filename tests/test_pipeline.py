@@ -350,6 +350,27 @@ def test_a_slurm_sweep_asks_for_what_its_runs_need(monkeypatch):
     assert cluster.minutes("1-2") == 1560 and cluster.minutes("infinite") is None
 
 
+def test_a_signal_another_thread_received_stops_the_run_at_its_next_chunk():
+    """The kernel may give SIGTERM to any thread (a BLAS thread of numpy: SLURM's scancel on a
+    busy machine); the main thread, which holds the GIL through the compiled chunks, learns of
+    it when it asks between chunks, not at SIGKILL. A thread of C code (sleeping 5 s unless a
+    signal wakes it) takes the signal; the calls of ``held`` keep the GIL, as the event loop
+    does."""
+    import ctypes
+    import signal
+
+    from sim.pipeline.interruption import Interruption
+
+    libc, held = ctypes.CDLL(None), ctypes.PyDLL(None)
+    thread = ctypes.c_ulong()
+    assert libc.pthread_create(ctypes.byref(thread), None, libc.sleep, ctypes.c_void_p(5)) == 0
+    with Interruption() as interruption:
+        assert not interruption.requested
+        held.pthread_kill(thread, signal.SIGTERM)
+        held.pthread_join(thread, None)  # its handler has run in that thread
+        assert interruption.requested and interruption.reason == "terminated"
+
+
 def test_a_job_on_slurm_is_stopped_alone_and_the_schedulers_words_come_in_one_line(
         monkeypatch):
     """sim.pipeline.cluster in a job (its SLURM id from the environment): a signal before the

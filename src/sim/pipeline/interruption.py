@@ -7,6 +7,19 @@ import threading
 from sim.pipeline import sweep_stop
 
 
+def _run_pending_handlers():
+    """Run the handlers of signals that another thread of this process received, now.
+
+    The kernel gives a signal sent to the process to any thread that does not block it, and
+    numpy's BLAS threads do not: on a busy machine SIGTERM mostly lands on one of them
+    (seen with SLURM's ``scancel``). Python runs a handler only in the main thread, and
+    for a signal another thread received only once the main thread next takes the GIL, which
+    the event loop holds through its compiled chunks: the request waited until SIGKILL.
+    ``signal.pthread_sigmask`` ends by running the pending handlers (CPython's
+    ``PyErr_CheckSignals``); an empty set leaves the mask as it is."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, ())
+
+
 class Interruption:
     """SIGINT (Ctrl-C) or SIGTERM (a batch scheduler's time limit) asks the run to stop: the
     engine finishes its compiled chunk, the runner writes a final snapshot and checkpoint,
@@ -44,6 +57,8 @@ class Interruption:
 
     @property
     def requested(self):
+        """Whether the run is asked to stop; asked between chunks, in the main thread."""
+        _run_pending_handlers()
         if self.signal is None:
             self.signal = Interruption.early
         if self.signal is None and Interruption.sweep_dir is not None:
