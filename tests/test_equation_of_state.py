@@ -14,6 +14,7 @@ from sim.analysis.equation_of_state import (
     pressure_area,
     reduced_pressure_d2,
     run_pressure,
+    time_weighted,
 )
 
 
@@ -88,7 +89,7 @@ def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
                  "stop.collisions=144000", "output.every_collisions=3600",
                  "output.progress=false"]
     with open_run(run(compose_config(overrides), tmp_path / "a")) as data:
-        pressure, collisions = block_pressures(data)
+        pressure, collisions, elapsed = block_pressures(data)
         assert pressure.size == 40 and np.all(np.diff(collisions) == 3600)
         k = 5
         expected = reduced_pressure_d2(
@@ -98,6 +99,9 @@ def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
         assert pressure[k] == pytest.approx(expected, rel=1e-13)
         point = run_pressure(data)
         assert point.cut + point.blocks == 40
+        kept = slice(point.cut, None)  # the production's pressure over its time
+        assert point.mean == pytest.approx(
+            np.sum(pressure[kept] * elapsed[kept]) / np.sum(elapsed[kept]), rel=1e-12)
         z = kolafa_rottner_z(0.6)  # βP/ρ, and ρ d² = 4φ/π
         assert point.mean == pytest.approx(z * 4.0 * 0.6 / math.pi, rel=0.02)
         # round-off's drift of K over a long run is passed; a dissipative run's is not
@@ -112,6 +116,25 @@ def test_block_pressures_and_run_pressure_of_a_run(tmp_path):
     drifting = run(compose_config([*overrides, "disks.zero_momentum=false"]), tmp_path / "b")
     with open_run(drifting) as data, pytest.raises(ValueError, match="total momentum"):
         block_pressures(data)
+
+
+def test_blocks_of_equal_collisions_are_weighted_by_their_time():
+    """A gas of constant pressure as a Poisson process of collisions, blocks of m = 20 of
+    them: a block lasts t_b ~ Gamma(m) and its pressure X_b/t_b averages m/(m − 1) of the
+    true one, block by block. Over the time of all blocks (:func:`time_weighted`) the mean is
+    the ratio of sums and the true pressure within its blocking error."""
+    rng = np.random.default_rng(5)
+    m, blocks, rate, true = 20, 40_000, 3.0, 7.0
+    elapsed = rng.gamma(m, 1.0 / rate, blocks)
+    virial = true / rate * rng.exponential(1.0, (blocks, m)).sum(axis=1)  # E = true · t
+    pressure = virial / elapsed
+    z = time_weighted(pressure, elapsed)
+    assert z.mean() == pytest.approx(virial.sum() / elapsed.sum(), rel=1e-12)
+    mean, error, converged, _ = blocking(z)
+    assert converged and abs(mean - true) < 4.0 * error
+    plain, plain_error, _, _ = blocking(pressure)
+    assert plain == pytest.approx(true * m / (m - 1), rel=4.0 * plain_error / plain)
+    assert plain - true > 20.0 * plain_error
 
 
 def test_blocking_of_a_series_too_short_to_converge_gives_its_largest_error():

@@ -95,7 +95,7 @@ def trace(dataset, n):
     digits). None for other N."""
     if n != TRACED:
         return None
-    pressure, ends = block_pressures(dataset)
+    pressure, ends, _ = block_pressures(dataset)
     last = dataset.isel(time=-1)
     psi = last["bond_order"].values
     diameter = 2.0 * float(dataset["radius"].values[0])

@@ -75,7 +75,7 @@ from sim.storage.whole_file import whole_file
 LEDGER = Path(__file__).resolve().parents[2] / "docs" / "results" / "melting.json"
 #: the version of :func:`analyse`'s rules a record was made with; a record of another is
 #: made anew from its run file when the study starts
-ANALYSIS = 3
+ANALYSIS = 4
 #: the stop reasons of a run file whose round has not reached its length: stopped by a
 #: signal, or still "running" in the file of a killed process
 CUT_SHORT = ("interrupted", "terminated", "running")

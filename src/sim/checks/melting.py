@@ -6,7 +6,8 @@ A state point: N disks at packing fraction φ in a periodic box of aspect ratio 
 (L_y = 1), placed as ``auto`` places a gas (:func:`sim.pipeline.initial.compressed` above
 φ = 0.6), Maxwellian at T = 1 with zero total momentum; an equilibration of ``warmup``
 collisions per disk; then blocks of collisions whose pressures (:func:`sim.analysis.
-equation_of_state.reduced_pressure_d2`, exact for zero momentum) give the mean and its
+equation_of_state.reduced_pressure_d2`, exact for zero momentum), averaged over the time
+they span (:func:`sim.analysis.equation_of_state.time_weighted`), give the mean and its
 blocking error.
 """
 
@@ -17,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.analysis.equation_of_state import blocking, reduced_pressure_d2
+from sim.analysis.equation_of_state import blocking, reduced_pressure_d2, time_weighted
 from sim.checks.rows import Check
 from sim.engine import Boundary, Engine
 from sim.pipeline.initial import compressed, maxwellian, random_sequential, remove_drift
@@ -62,13 +63,14 @@ def state_point(n, aspect, phi, seed=0, warmup=100, collisions=20_000, blocks=25
     engine.run(collisions=warmup * n)
     per_block = max(1, collisions * n // blocks)
     kinetic = engine.kinetic_energy()
-    pressures = []
+    pressures, spans = [], []
     for _ in range(blocks):
         virial, started = engine.virial, engine.time
         engine.run(collisions=engine.collisions + per_block)
-        pressures.append(reduced_pressure_d2(n, kinetic, engine.virial - virial,
-                                             engine.time - started, aspect, 2.0 * radius))
-    mean, error, converged, _ = blocking(pressures)
+        spans.append(engine.time - started)
+        pressures.append(reduced_pressure_d2(n, kinetic, engine.virial - virial, spans[-1],
+                                             aspect, 2.0 * radius))
+    mean, error, converged, _ = blocking(time_weighted(pressures, spans))
     return mean, error, converged, warmup + blocks * per_block / n
 
 
