@@ -115,6 +115,21 @@ def _stop(process):
         process.wait()
 
 
+def _drain(environment):
+    """Cancel every job of the cluster and wait (at most STOP_SECONDS) until none is left:
+    a job step that outlives the controller waits for it for ever (its ``slurmstepd`` was
+    seen still there 20 minutes on)."""
+    subprocess.run(["scancel", f"--partition={PARTITION}"], env=environment,
+                   capture_output=True)
+    deadline = time.monotonic() + STOP_SECONDS
+    while time.monotonic() < deadline:
+        listed = subprocess.run(["squeue", "--noheader"], env=environment,
+                                capture_output=True, text=True)
+        if listed.returncode != 0 or not listed.stdout.strip():
+            return
+        time.sleep(0.5)
+
+
 def _node_idle(environment):
     state = subprocess.run(["sinfo", "--noheader", "--format=%t"], env=environment,
                            capture_output=True, text=True)
@@ -155,5 +170,7 @@ def local_slurm(folder, cores=None):
             os.environ.pop("SLURM_CONF", None)
         else:
             os.environ["SLURM_CONF"] = previous
+        if len(started) == 3 and all(p.poll() is None for p in started):
+            _drain(environment)
         for process in reversed(started):
             _stop(process)
