@@ -260,11 +260,12 @@ def main():
                 if not (sweeping and cluster.slurm_launcher(args)
                         and type(error).__module__.startswith("submitit.")):
                     raise
-                if cluster.refused(error):
+                refused = cluster.refused(error)  # nothing was queued
+                if refused:
                     _forget_submission(sweep_dir)
                 leave(cluster.scheduler_error(error, sweep_dir,
                                               hydra_settings(args).hydra.launcher),
-                      EXIT_BAD_CONFIG if cluster.refused(error) else EXIT_RUN_FILE)
+                      EXIT_BAD_CONFIG if refused else EXIT_RUN_FILE)
             if sweeping:  # the sweep is over: a late signal must not break the report
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)

@@ -52,11 +52,15 @@ def time_limit_warning():
     return signal.Signals["SIG" + os.environ.get("SUBMITIT_PREEMPT_SIGNAL", "USR2")]
 
 
+def _sends_to_slurm(launcher):
+    """Whether the launcher config ``launcher`` is submitit's SLURM launcher."""
+    return str(launcher.get("_target_", "")).endswith("SlurmLauncher")
+
+
 def slurm_job(launcher):
     """Whether this process runs a job that submitit started on SLURM for a sweep whose
     launcher config is ``launcher``."""
-    return (os.environ.get("SUBMITIT_EXECUTOR") == "slurm"
-            and str(launcher.get("_target_", "")).endswith("SlurmLauncher"))
+    return os.environ.get("SUBMITIT_EXECUTOR") == "slurm" and _sends_to_slurm(launcher)
 
 
 def _ignored(signum):
@@ -76,8 +80,7 @@ def take_signals():
 
 def slurm_launcher(args):
     """Whether the command line's sweep goes to SLURM through submitit."""
-    target = str(hydra_settings(args).hydra.launcher.get("_target_", ""))
-    return target.endswith("SlurmLauncher")
+    return _sends_to_slurm(hydra_settings(args).hydra.launcher)
 
 
 def minutes(text):
