@@ -170,8 +170,8 @@ def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_sho
     assert study.next_length(point, unknown) == 40_000
     drifting = dict(record, drift=4.0)
     assert study.status(point, drifting) == "running"
-    assert study.status(point, dict(record, cut=33)) == "done"  # 33 of 133 blocks cut
-    assert study.status(point, dict(record, cut=34)) == "running"  # more than a quarter
+    assert study.status(point, dict(record, cut=11)) == "done"  # 11 of 111 blocks cut
+    assert study.status(point, dict(record, cut=12)) == "running"  # more than a tenth
     few = dict(record, blocks=40, cut=60, err=0.001)  # asks 6000 cut + 64 blocks of 100
     assert study.status(point, few) == "running" and study.next_length(point, few) == 15_000
     fewer = dict(few, collisions_per_disk=2_000)  # 1200 cut + 6400: more than 1.5 times
