@@ -34,8 +34,7 @@ observers         ``unwrap``, ``pressure_tensor`` and ``event_log``, every disk 
 compress          ``growth`` (and its system event, the rescaling); radii and species per disk
 square_well       a stepped pair potential (``potential_steps``), every disk alike; its
                   shoulder twin too
-gas_lookahead     gas, looking ahead
-crater_lookahead  crater, looking ahead
+gas_lookahead     gas, looking ahead (the crater's variant looking ahead is ``slow``)
 ================  ==============================================================================
 """
 
@@ -86,9 +85,9 @@ CANONICAL = {**{scene: (scene,) for scene in ("gas", "mixture", "cooling", "driv
                               "restitution.wall=0.9", "tc.time=1e-4"),
              "square_well": ("square_well",),
              "observers": ("gas", *OBSERVERS),
-             "gas_lookahead": ("gas",), "crater_lookahead": ("crater",)}
+             "gas_lookahead": ("gas",)}
 #: the canonical variants that look ahead (``Engine.lookahead``), whatever their N
-LOOKAHEAD = ("gas_lookahead", "crater_lookahead")
+LOOKAHEAD = ("gas_lookahead",)
 
 
 def compose_scene(name, *overrides):

@@ -91,7 +91,6 @@ from sim.engine.neighbours import list_start, rebuild_neighbours
 from sim.engine.pairs import (
     apply_pair_event,
     collide,
-    own_apply,
     pair_event_time,
     pair_reach,
 )
@@ -363,7 +362,7 @@ def run_events(disks, schedule, neighbours, box, effects, pair, system, lookahea
             j = partner
             fly(j, t, disks.table, box, effects.gravity, effects.images)
             events += 1
-            if pair is not None and own_apply(pair):
+            if pair is not None:
                 lost, virial, log_full, culprit, contact = apply_pair_event(
                     pair, optional_entry(s.pair_event, i, 0), i, j, t, t_origin, disks, neighbours,
                     box, effects, tallies, collisions + wall_contacts + 1)

@@ -5,7 +5,7 @@ and applies the earliest. By default (``Parts.pair`` None, :mod:`sim.engine.grou
 is two hard disks: their contact at σ_ij = R_i + R_j (:func:`hard_core_time`, the filter and
 the root of :mod:`sim.engine.kinematics`) and the impulse of :func:`collide` (restitution,
 the TC model, rough disks, the recorders); otherwise the rules of the pair's kind
-(:func:`pair_event_time`, and :func:`apply_pair_event` when :func:`own_apply`).
+(:func:`pair_event_time`, :func:`apply_pair_event`).
 
 A kind of pair interaction is a NamedTuple class (its value: the constants of the rule) with
 compiled rules registered for it by :func:`rules`; numba picks them by the value's type while
@@ -107,21 +107,6 @@ def _rules_of(value):
     return RULES[kind]
 
 
-def own_apply(pair):
-    """Whether the pair interaction ``pair`` (not None) applies its events by a rule of its
-    own kind, else :func:`collide`. A constant while numba compiles the loop, which calls
-    :func:`collide` directly when it is False or ``pair`` None: the contact is then compiled
-    as it was before the seam existed (through an overload it took 3 s more of the first
-    compilation)."""
-    return keeps(pair, "apply")
-
-
-@overload(own_apply, inline="always")
-def _own_apply(pair):
-    own = _rules_of(pair).apply is not None
-    return lambda pair: own
-
-
 def keeps(pair, rule):
     """Whether the kind of ``pair`` (None: hard disks) has the optional rule ``rule``
     (``"apply"``, ``"reach"``, ``"initial_state"``, ``"energy"``): the engine then
@@ -172,20 +157,31 @@ def _pair_event_time(pair, i, j, rx, ry, vx, vy, sigma, sigma_rate, tau, state, 
 
 def apply_pair_event(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
                      contact):
-    """Apply the pair event ``event`` of disks i and j at time t by the rule of ``pair``'s
-    kind; the loop calls it when :func:`own_apply`. Returns what :func:`collide` returns and
-    whether the event was a contact."""
-    return RULES[type(pair)].apply(pair, event, i, j, t, t_origin, disks, neighbours, box,
-                                   effects, tallies, contact)
+    """Apply the pair event ``event`` of disks i and j at time t by the ``apply`` rule of
+    ``pair``'s kind, or as a contact (:func:`collide`) for a kind without one. Returns what
+    :func:`collide` returns and whether the event was a contact. The loop calls it for every
+    pair event of a scene with a pair interaction, and :func:`collide` directly for hard
+    disks, so that one copy of the contact is compiled into the loop, not two: with a second,
+    never-taken copy beside the stepped potential's, the first compilation of the square-well
+    loop took 50 s, 24 of them typing it."""
+    rule = RULES[type(pair)].apply
+    if rule is None:
+        return (*collide(i, j, t, t_origin, disks, box, effects, tallies, contact), True)
+    return rule(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
+                contact)
 
 
 @overload(apply_pair_event, inline="always")
 def _apply_pair_event(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
                       contact):
-    apply = None if pair is types.none else _rules_of(pair).apply
-    if apply is None:  # typed for a kind without an apply rule of its own, never called
-        return lambda pair, event, i, j, t, t_origin, disks, neighbours, box, effects, \
-            tallies, contact: (0.0, 0.0, False, -1, False)
+    apply = _rules_of(pair).apply
+    if apply is None:
+        def as_contact(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
+                       contact):
+            lost, virial, log_full, culprit = collide(i, j, t, t_origin, disks, box, effects,
+                                                      tallies, contact)
+            return lost, virial, log_full, culprit, True
+        return as_contact
     return lambda pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies, \
         contact: apply(pair, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
                        contact)
