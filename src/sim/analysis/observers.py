@@ -13,8 +13,6 @@ collision virial tensor (``pressure_tensor``, :mod:`sim.effects.pressure_tensor`
 """
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from sim.analysis.cells import cell_index, granular_temperature, grid
 from sim.analysis.packing import bond_order
@@ -87,6 +85,9 @@ class Clusters:
         close = tree.sparse_distance_matrix(tree, 2.0 * float(radius.max()) + self.gap,
                                             output_type="ndarray")
         linked = close["v"] < radius[close["i"]] + radius[close["j"]] + self.gap
+        from scipy.sparse import coo_matrix  # here: every run's start would import it
+        from scipy.sparse.csgraph import connected_components
+
         n = position.shape[0]
         graph = coo_matrix((np.ones(linked.sum()), (close["i"][linked], close["j"][linked])),
                            shape=(n, n))

@@ -22,7 +22,6 @@ Positions float64[n, 2] in the box [0, L_x] × [0, L_y], radii float64[n].
 """
 
 import numpy as np
-from scipy.spatial import Delaunay
 
 from sim.checks.audit import kd_tree
 from sim.engine.box import folded, nearest_images
@@ -100,6 +99,8 @@ def voronoi_neighbours(position, box, periodic):
         points.append(moved[near])
         owner.append(np.flatnonzero(near))
     points, owner = np.vstack(points), np.concatenate(owner)
+    from scipy.spatial import Delaunay  # here: every run's start would import it
+
     triangles = Delaunay(points).simplices
     edges = np.vstack([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
     edges = edges[(edges < n).any(axis=1)]  # an edge of an original disk

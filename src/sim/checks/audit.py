@@ -5,7 +5,6 @@ neighbour lists, so it can catch their bugs.
 """
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from sim.engine.box import folded, nearest_images
 
@@ -14,6 +13,8 @@ def kd_tree(position, box, periodic):
     """A k-d tree of ``position`` float64[n, 2] that measures distances with the minimum image
     on periodic axes (scipy's periodicity is per axis: a huge side makes a walled axis
     non-periodic)."""
+    from scipy.spatial import cKDTree  # here: every run's start would import it
+
     box = np.asarray(box, dtype=np.float64)
     if not any(periodic):
         return cKDTree(position)
