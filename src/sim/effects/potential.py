@@ -44,7 +44,7 @@ from sim.engine.kinematics import (
     pair_contact_time,
     pair_exit_time,
 )
-from sim.engine.pairs import collide, pair_state, rules, set_pair_state
+from sim.engine.pairs import collide, hard_core_time, pair_state, rules, set_pair_state
 from sim.engine.parameters import per_disk
 from sim.engine.sizing import periodic_room
 from sim.engine.stamps import invalidate
@@ -180,23 +180,16 @@ def step_event_time(value, i, j, rx, ry, vx, vy, sigma, tau, state, disks):
     inner edge reached moving in, if the pair reaches it (and may before τ, the filter), else
     the outer one reached moving out (none beyond the last step)."""
     a, b = per_disk(disks.species, i), per_disk(disks.species, j)
-    last = value.count[a, b]
-    if last == 0:  # a pair of hard disks: its core
-        inner, event = sigma, CORE
-    elif state == 0:  # the last step, from beyond it
-        inner, event = value.steps[a, b, last - 1] * sigma, INWARD
-    elif state == 1:
-        inner, event = sigma, CORE
-    else:
-        inner, event = value.steps[a, b, state - 2] * sigma, INWARD
-    # one copy of the contact's filter and root, whatever the shell (each copy inlined into
-    # the loop's prediction costs seconds of its first compilation)
+    if value.count[a, b] == 0:  # a pair of hard disks
+        return hard_core_time(rx, ry, vx, vy, sigma, tau), CORE
+    if state == 0:  # the last step, from beyond it
+        return hard_core_time(rx, ry, vx, vy, value.steps[a, b, value.count[a, b] - 1] * sigma,
+                              tau), INWARD
+    inner = sigma if state == 1 else value.steps[a, b, state - 2] * sigma
     if may_touch_before(rx, ry, vx, vy, inner, tau):
         t_in = pair_contact_time(rx, ry, vx, vy, inner)
-        if t_in < INF or last == 0 or state == 0:  # the filter passes pairs that miss, too
-            return t_in, event
-    elif last == 0 or state == 0:
-        return INF, event
+        if t_in < INF:  # the filter passes pairs that miss the inner edge, too
+            return t_in, CORE if state == 1 else INWARD
     return pair_exit_time(rx, ry, vx, vy, value.steps[a, b, state - 1] * sigma), OUTWARD
 
 
@@ -206,7 +199,7 @@ def shell_energy(value, a, b, state):
     return 0.0 if state == 0 else value.energies[a, b, state - 1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def cross_step(value, event, i, j, t, t_origin, disks, neighbours, box, effects, tallies,
                contact):
     """Apply the pair event ``event`` of disks i and j, both flown to time t: the core
