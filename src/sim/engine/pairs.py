@@ -161,9 +161,9 @@ def apply_pair_event(pair, event, i, j, t, t_origin, disks, neighbours, box, eff
     ``pair``'s kind, or as a contact (:func:`collide`) for a kind without one. Returns what
     :func:`collide` returns and whether the event was a contact. The loop calls it for every
     pair event of a scene with a pair interaction, and :func:`collide` directly for hard
-    disks, so that one copy of the contact is compiled into the loop, not two: with a second,
-    never-taken copy beside the stepped potential's, the first compilation of the square-well
-    loop took 50 s, 24 of them typing it."""
+    disks, so that one copy of the contact is compiled into the loop, not a second one beside
+    the stepped potential's that is never taken (which made the square-well loop's first
+    compilation a quarter slower, ``docs/performance-history.md``)."""
     rule = RULES[type(pair)].apply
     if rule is None:
         return (*collide(i, j, t, t_origin, disks, box, effects, tallies, contact), True)
