@@ -149,9 +149,9 @@ def warm(names):
 
 def shares(names, processes):
     """``names`` dealt into ``processes`` lists of about equal length (one variant each). The
-    order of :data:`CANONICAL` balances two processes: dealt so, from an empty cache, they
-    took 113 and 110 s, against 116 and 140 s with compress third from the end, where cooling
-    now stands (compress, whose disks grow, is among the slowest variants)."""
+    order of :data:`CANONICAL` balances two processes (compress, whose disks grow, and
+    square_well are the slowest variants; the seconds of each process from an empty cache are
+    in ``docs/performance-history.md``, the quick suite's compilation)."""
     return [names[k::processes] for k in range(min(processes, len(names)))]
 
 
