@@ -194,8 +194,8 @@ def draw_bond_order(records, todo, out, results):
                      label="orientation of the local hexagon, arg(ψ₆)/6 (rad); "
                            "brightness |ψ₆|")
         left.set(xlim=(0, box[0]), ylim=(0, box[1]), aspect="equal", xticks=[], yticks=[])
-        left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start, after "
-                       f"{per_disk:.3g} collisions per disk (seed {seed})", fontsize=10)
+        left.set_title(f"N = 128², φ = {point.phi:.3f}, {point.group.start} start,\n"
+                       f"after {per_disk:.3g} collisions per disk (seed {seed})", fontsize=10)
         break
     else:  # a clone with the committed results alone: the snapshot needs a run file
         left.text(0.5, 0.5, "no run file of N = 128² here:\nthe snapshot is drawn where the "
