@@ -87,8 +87,8 @@ def test_the_study_resumes_a_cut_short_point_to_the_same_bits_and_runs_nothing_t
     with open(tmp_path / "whole" / "results" / "melting.csv", encoding="utf-8") as file:
         rows = list(csv.DictReader(file))
     assert [r["phi"] for r in rows] == ["0.650", "0.700"]
-    assert set(rows[0]) == {"n", "aspect", "phi", "start", "collisions_per_disk", "bPd2",
-                            "err", "psi6"}
+    assert set(rows[0]) == {"n", "aspect", "phi", "start", "seed", "collisions_per_disk",
+                            "bPd2", "err", "psi6"}
     published = reference(72, "1:1")[1]
     assert abs(float(rows[0]["bPd2"]) - published[0]) < 5 * float(rows[0]["err"]) + 0.01
     files = sorted((tmp_path / "whole" / "runs").glob("*/run.h5"))
@@ -187,3 +187,18 @@ def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_sho
     assert study.next_length(point, record, apart) == 15_000
     failed = {"collisions_per_disk": 5_000, "failed": "a run to its collisions"}
     assert study.status(point, failed) == "failed" and study.next_length(point, failed) is None
+
+
+def test_the_runs_of_one_state_point_from_other_starts_or_seeds_are_its_twins():
+    """plan.twins: the points of the plan at the same N, box and φ from another start or with
+    another seed, and no others; each point's run carries its group's seed."""
+    _study()
+    plan = sys.modules["plan"]
+    todo = plan.points(plan.PLAN, Path("unused"))
+    by_folder = {p.folder.name: p for p in todo}
+    first, second = by_folder["224-square-0.720"], by_folder["224-square-seed1-0.720"]
+    assert plan.twins(first, todo) == [second] and plan.twins(second, todo) == [first]
+    assert plan.twins(by_folder["224-square-0.712"], todo) == []
+    melted = by_folder["16384-square-melted-0.704"]
+    assert plan.twins(by_folder["16384-square-0.704"], todo) == [melted]
+    assert "seed=1" in second.overrides(1000) and "seed=0" in first.overrides(1000)

@@ -14,14 +14,15 @@ from sim.storage.whole_file import whole_file
 
 def write_tables(records, results):
     """melting.csv and melting_reference.csv, one row per run."""
-    columns = ("n", "aspect", "phi", "start", "collisions_per_disk", "bPd2", "err", "psi6")
+    columns = ("n", "aspect", "phi", "start", "seed", "collisions_per_disk", "bPd2", "err",
+               "psi6")
     with whole_file(results / "melting.csv") as partial, \
             open(partial, "w", newline="", encoding="utf-8") as file:
         writer = csv.writer(file)
         writer.writerow(columns)
         for r in records:
             writer.writerow([r["n"], f"{r['aspect']:.12g}", f"{r['phi']:.3f}", r["start"],
-                             f"{r['collisions_per_disk']:.0f}", f"{r['bPd2']:.5f}",
+                             r["seed"], f"{r['collisions_per_disk']:.0f}", f"{r['bPd2']:.5f}",
                              f"{r['err']:.5f}", f"{r['psi6']:.4f}"])
     with whole_file(results / "melting_reference.csv") as partial, \
             open(partial, "w", newline="", encoding="utf-8") as file:
@@ -41,14 +42,14 @@ SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157,
 def extrema(records):
     """Per N and box with a loop in its published curve: the published maximum and minimum
     from all its points and from those at our φ only, and ours (:func:`loop_extrema`, one
-    run per φ: the first of its starts in ``STARTS``), where our points show one. The vertex
-    of a parabola depends on the points fitted: ours compare with the published ones at our
-    φ."""
+    run per φ: the first of its starts in ``STARTS``, the lowest seed), where our points show
+    one. The vertex of a parabola depends on the points fitted: ours compare with the
+    published ones at our φ."""
     found = {}
     for n, box in dict.fromkeys((r["n"], r["box"]) for r in records):
         one = {}
         for r in sorted((r for r in records if (r["n"], r["box"]) == (n, box)),
-                        key=lambda r: STARTS.index(r["start"])):
+                        key=lambda r: (STARTS.index(r["start"]), r["seed"])):
             one.setdefault(round(r["phi"], 6), r)
         mine = [one[phi] for phi in sorted(one)]
         phi, pressure, error, _ = reference(n, box)
@@ -95,8 +96,8 @@ def write_markdown(records, found, results):
              f"least {PRODUCTION_BLOCKS} blocks are kept, at most {CUT:.0%} of the blocks "
              f"are cut as equilibration (a longer cut is a transient the run is too short "
              f"for, or rare excursions taken for one) and its βP d² agrees with that of "
-             f"the runs of the same state point from other starts within {AGREEMENT:g} "
-             f"combined standard errors; else it runs on to {MARGIN:g} times "
+             f"the runs of the same state point from other starts or seeds within "
+             f"{AGREEMENT:g} combined standard errors; else it runs on to {MARGIN:g} times "
              f"the length its error asks for ({GROWTH[0]:g} to {GROWTH[1]:g} times its "
              f"length so far). Targets: "
              + "; ".join(f"{g.name} {g.target:g} (a block every {g.block} collisions per "
@@ -105,7 +106,8 @@ def write_markdown(records, found, results):
     for name in dict.fromkeys(r["group"] for r in measured):
         rows = sorted((r for r in measured if r["group"] == name), key=lambda r: r["phi"])
         phi, pressure, error, _ = reference(rows[0]["n"], rows[0]["box"])
-        lines += [f"**N = {rows[0]['n']}, box {rows[0]['box']}, {rows[0]['start']} start**",
+        lines += [f"**N = {rows[0]['n']}, box {rows[0]['box']}, {rows[0]['start']} start, "
+                  f"seed {rows[0]['seed']}**",
                   "", "| φ | βP d², sim | published | difference / combined error | "
                   "collisions per disk | equilibration cut | drift | ⟨|Ψ₆|⟩ | state |",
                   "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
