@@ -116,6 +116,7 @@ def test_a_committed_record_of_older_rules_is_run_again_to_its_recorded_length(t
     point = plan.points(plan.QUICK, tmp_path)[0]
     g = point.group
     older = {"group": g.name, "n": g.n, "box": g.box, "phi": point.phi, "start": g.start,
+             "seed": 0,
              "analysis": study.ANALYSIS - 1, "collisions_per_disk": 3 * g.first,
              "cpu_seconds": 5.0, "status": "done"}
     ledger = tmp_path / "melting.json"
@@ -135,6 +136,7 @@ def test_an_adopted_point_whose_rerun_was_cut_short_goes_on_to_its_recorded_leng
     point = plan.points(plan.QUICK, tmp_path)[0]
     g = point.group
     done = {"group": g.name, "n": g.n, "box": g.box, "phi": point.phi, "start": g.start,
+            "seed": 0,
             "analysis": study.ANALYSIS, "collisions_per_disk": g.first, "cpu_seconds": 5.0,
             "err": 0.0, "converged": True, "drift": 0.0, "blocks": 100, "cut": 0,
             "bPd2": 1.0, "status": "done"}
@@ -190,15 +192,46 @@ def test_a_point_runs_on_to_the_length_its_error_asks_for_and_stops_where_it_sho
 
 
 def test_the_runs_of_one_state_point_from_other_starts_or_seeds_are_its_twins():
-    """plan.twins: the points of the plan at the same N, box and φ from another start or with
-    another seed, and no others; each point's run carries its group's seed."""
+    """plan.points and plan.twins: a point per φ and seed; its twins are the points at the
+    same N, box and φ from another start or with another seed, and no others; replicas (the
+    same start, other seeds) share the group's target as √(replicas) times each run's."""
     _study()
     plan = sys.modules["plan"]
     todo = plan.points(plan.PLAN, Path("unused"))
     by_folder = {p.folder.name: p for p in todo}
-    first, second = by_folder["224-square-0.720"], by_folder["224-square-seed1-0.720"]
+    first, second = by_folder["224-square-0.720"], by_folder["224-square-replicas-0.720-seed1"]
     assert plan.twins(first, todo) == [second] and plan.twins(second, todo) == [first]
     assert plan.twins(by_folder["224-square-0.712"], todo) == []
+    assert by_folder["224-square-0.712"].target == 0.003
+    assert first.target == second.target == pytest.approx(0.003 * 2**0.5)
     melted = by_folder["16384-square-melted-0.704"]
     assert plan.twins(by_folder["16384-square-0.704"], todo) == [melted]
-    assert "seed=1" in second.overrides(1000) and "seed=0" in first.overrides(1000)
+    assert by_folder["16384-square-0.704"].target == melted.target == 0.003
+    compressed = [by_folder[f"16384-square-replicas-0.716-seed{s}"] for s in (1, 2)]
+    assert {p.replicas for p in [by_folder["16384-square-0.716"], *compressed]} == {3}
+    assert by_folder["16384-square-melted-0.716"].replicas == 1
+    assert "seed=2" in compressed[1].overrides(1000) and "seed=0" in first.overrides(1000)
+
+
+def test_replicas_combine_to_their_weighted_mean():
+    """tables.estimates: the runs of one N, box, φ and start with different seeds give
+    Σ p/σ² / Σ 1/σ² ± (Σ 1/σ²)^(−1/2), done only when each replica of the plan is; a run
+    alone is itself."""
+    _study()
+    tables = sys.modules["tables"]
+    run = {"n": 224, "box": "1:1", "phi": 0.72, "start": "compressed", "replicas": 2}
+    records = [dict(run, seed=0, bPd2=9.0, err=0.003, status="done"),
+               dict(run, seed=1, bPd2=9.1, err=0.004, status="running"),
+               dict(run, phi=0.712, seed=0, bPd2=8.7, err=0.01, status="done", replicas=1)]
+    both, alone = tables.estimates(records)
+    w = np.array([1 / 0.003**2, 1 / 0.004**2])
+    assert both["seeds"] == [0, 1] and both["status"] == "running"
+    assert both["bPd2"] == pytest.approx((9.0 * w[0] + 9.1 * w[1]) / w.sum())
+    assert both["err"] == pytest.approx(0.0024)  # 0.003 · 0.004 / 0.005
+    assert (alone["bPd2"], alone["err"], alone["status"]) == (8.7, 0.01, "done")
+    unknown = tables.estimates([records[0], dict(records[1], err=float("nan"))])[0]
+    assert np.isnan(unknown["bPd2"]) and np.isnan(unknown["err"])
+    first, = tables.estimates(records[:1])  # its replica not begun: not done
+    assert first["status"] == "running" and first["bPd2"] == 9.0
+    both = tables.estimates([records[0], dict(records[1], status="longest")])[0]
+    assert both["status"] == "longest"

@@ -174,8 +174,8 @@ def draw_bond_order(records, todo, out, results):
             run_data = open_run(point.folder / "run.h5")
         except RunFileError:  # --report while the study runs it on: the next one
             continue
-        recorded = next(r["collisions_per_disk"] for r in records if
-                        (r["group"], r["phi"]) == (point.group.name, point.phi))
+        recorded = next(r["collisions_per_disk"] for r in records if (r["group"], r["phi"],
+                        r["seed"]) == (point.group.name, point.phi, point.seed))
         with run_data:
             last = run_data.isel(time=-1)
             per_disk = float(last["collisions"].values) / point.group.n

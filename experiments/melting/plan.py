@@ -2,6 +2,7 @@
 published sizes, boxes and packing fractions, the rules that end a point's runs, and the
 points with their run folders."""
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,9 +33,10 @@ class Group:
     """State points of one N and box: ``phis`` (published packing fractions), started as
     ``start`` (``compressed``: a random gas compressed by growing disks; ``melted``: a
     hexagonal lattice melted by a short elastic run; ``lattice``: the hexagonal lattice
-    that fills the box, jittered) with ``seed``; a snapshot, one block of the
-    pressure, every ``block`` collisions per disk; ``first`` collisions per disk in the first
-    round, at most ``longest``; done at an error of βP d² of at most ``target``."""
+    that fills the box, jittered), one run with each of ``seeds``; a snapshot, one block of
+    the pressure, every ``block`` collisions per disk; ``first`` collisions per disk in the
+    first round, at most ``longest``; an error of βP d² of at most ``target`` for the state
+    point and start (:attr:`Point.target`)."""
 
     name: str
     n: int
@@ -45,7 +47,7 @@ class Group:
     first: int
     longest: int
     target: float
-    seed: int = 0
+    seeds: tuple = (0,)
 
 
 #: the published sizes and boxes (Li et al. 2022), with the published points dense where the
@@ -58,10 +60,13 @@ class Group:
 #: 0.0043 at 1.2·10⁶ collisions per disk, where its target asks about 2.7 times that
 #: length (``study.next_length``). N = 224 in the coexistence (φ = 0.704–0.712) had errors of
 #: 0.006–0.011 at 10⁷ collisions per disk, where its target asks 4–14 times that length.
-#: A second seed where the first run lies more than 3 combined errors from the published
-#: value: N = 72 in its lattice box at φ = 0.696, and N = 224 at 0.720, whose compressed
-#: fluid froze into one crystal that the run never left, its blocking error ten times below
-#: the published one. The runs of one state point run on until they agree (``AGREEMENT``)
+#: Runs again with other seeds, where one run lies more than 3 combined errors from the
+#: published value (N = 72 in its lattice box at φ = 0.696; N = 224 at 0.720, whose
+#: compressed fluid froze into one crystal that the run never left, its blocking error ten
+#: times below the published one), or where one run would need more hours than a job holds
+#: (N = 128² at 0.716 from the compressed start, about five on one core): replicas, run side
+#: by side, whose weighted mean is the state point's pressure (:func:`tables.estimates`)
+#: once they agree (``AGREEMENT``)
 PLAN = (
     Group("72-square", 72, "1:1", (0.650, 0.660, 0.670, 0.680, 0.686, 0.690, 0.694, 0.698,
                                    0.702, 0.706, 0.710, 0.720),
@@ -69,13 +74,13 @@ PLAN = (
     Group("72-lattice", 72, "9:8√3/2", (0.650, 0.670, 0.680, 0.684, 0.686, 0.688, 0.690,
                                         0.692, 0.694, 0.696, 0.698, 0.700, 0.706, 0.720),
           "compressed", 1000, 1_000_000, 60_000_000, 0.002),
-    Group("72-lattice-seed1", 72, "9:8√3/2", (0.696,),
-          "compressed", 1000, 1_000_000, 60_000_000, 0.002, seed=1),
+    Group("72-lattice-replicas", 72, "9:8√3/2", (0.696,),
+          "compressed", 1000, 1_000_000, 60_000_000, 0.002, seeds=(1,)),
     Group("224-square", 224, "1:1", (0.670, 0.680, 0.686, 0.690, 0.692, 0.694, 0.698, 0.702,
                                      0.704, 0.706, 0.708, 0.712, 0.720),
           "compressed", 500, 300_000, 60_000_000, 0.003),
-    Group("224-square-seed1", 224, "1:1", (0.720,),
-          "compressed", 500, 300_000, 60_000_000, 0.003, seed=1),
+    Group("224-square-replicas", 224, "1:1", (0.720,),
+          "compressed", 500, 300_000, 60_000_000, 0.003, seeds=(1,)),
     Group("870-square", 870, "1:1", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706, 0.710,
                                      0.712, 0.714, 0.716, 0.718),
           "compressed", 200, 100_000, 3_000_000, 0.003),
@@ -86,6 +91,8 @@ PLAN = (
           "lattice", 200, 100_000, 3_000_000, 0.003),
     Group("16384-square", 16384, "1:1", (0.698, 0.704, 0.708, 0.712, 0.716),
           "compressed", 1000, 80_000, 3_200_000, 0.003),
+    Group("16384-square-replicas", 16384, "1:1", (0.716,),
+          "compressed", 1000, 80_000, 3_200_000, 0.003, seeds=(1, 2)),
     Group("16384-square-melted", 16384, "1:1", (0.704, 0.716),
           "melted", 1000, 80_000, 3_200_000, 0.003),
 )
@@ -97,11 +104,21 @@ QUICK = (Group("72-square", 72, "1:1", (0.650, 0.700), "compressed", 500, 10_000
 
 @dataclass(frozen=True)
 class Point:
-    """One state point: its group and packing fraction, and its run folder."""
+    """One run of a state point: its group, packing fraction and seed, its run folder, and
+    how many runs of its N, box, φ and start the plan holds (``replicas``, itself
+    included)."""
 
     group: Group
     phi: float
     folder: Path
+    seed: int = 0
+    replicas: int = 1
+
+    @property
+    def target(self):
+        """The error of βP d² at which the run is done: the group's target times
+        √``replicas``, so that the weighted mean of the replicas reaches the group's."""
+        return self.group.target * math.sqrt(self.replicas)
 
     @property
     def aspect(self):
@@ -110,20 +127,25 @@ class Point:
     def overrides(self, collisions_per_disk):
         g = self.group
         return ["scenario=melting", f"disks.n={g.n}", f"disks.packing_fraction={self.phi}",
-                f"box.size=[{self.aspect!r},1.0]", f"disks.placement={g.start}", f"seed={g.seed}",
-                f"stop.collisions={collisions_per_disk * g.n}",
+                f"box.size=[{self.aspect!r},1.0]", f"disks.placement={g.start}",
+                f"seed={self.seed}", f"stop.collisions={collisions_per_disk * g.n}",
                 f"output.every_collisions={g.block * g.n}", "output.progress=false"]
 
 
 def points(plan, out):
-    return [Point(g, phi, Path(out) / "runs" / f"{g.name}-{phi:.3f}") for g in plan
-            for phi in g.phis]
+    """A point per group, φ and seed of ``plan``, its run folder under ``out``/runs (the
+    seed's in its name but for seed 0)."""
+    runs = [(g, phi, seed) for g in plan for phi in g.phis for seed in g.seeds]
+    keys = [(g.n, g.box, round(phi, 6), g.start) for g, phi, _ in runs]
+    return [Point(g, phi, Path(out) / "runs" / (f"{g.name}-{phi:.3f}"
+                                                + (f"-seed{seed}" if seed else "")),
+                  seed, keys.count(key)) for (g, phi, seed), key in zip(runs, keys, strict=True)]
 
 
 def twins(point, todo):
     """The points of ``todo`` at the state point of ``point`` (N, box, φ) from other starts
-    or seeds."""
+    or with other seeds."""
     return [other for other in todo
-            if (other.group.start, other.group.seed) != (point.group.start, point.group.seed)
+            if (other.group.start, other.seed) != (point.group.start, point.seed)
             and (other.group.n, other.group.box, other.phi)
             == (point.group.n, point.group.box, point.phi)]

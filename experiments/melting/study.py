@@ -61,7 +61,7 @@ from plan import (
     points,
     twins,
 )
-from tables import extrema, processor_hours, write_markdown, write_tables
+from tables import estimates, extrema, processor_hours, write_markdown, write_tables
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
@@ -87,9 +87,10 @@ def _record(point):
 
 
 def reached(point, record):
-    """Whether the point's run meets its group's target: error, convergence, no drift and
-    ``PRODUCTION_BLOCKS`` blocks kept, at most a share ``CUT`` of the blocks cut."""
-    return (record["err"] <= point.group.target and record["converged"]
+    """Whether the point's run meets its target (:attr:`plan.Point.target`): error,
+    convergence, no drift and ``PRODUCTION_BLOCKS`` blocks kept, at most a share ``CUT`` of
+    the blocks cut."""
+    return (record["err"] <= point.target and record["converged"]
             and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS
             and record["cut"] <= CUT * (record["cut"] + record["blocks"]))
 
@@ -128,7 +129,7 @@ def next_length(point, record, others=()):
         return None
     length = record["collisions_per_disk"]
     production = length * record["blocks"] / (record["blocks"] + record["cut"])
-    ratio = (record["err"] / g.target) ** 2 if math.isfinite(record["err"]) else math.inf
+    ratio = (record["err"] / point.target) ** 2 if math.isfinite(record["err"]) else math.inf
     asked = length - production + max(production * MARGIN * ratio, PRODUCTION_BLOCKS * g.block)
     asked = min(max(asked, GROWTH[0] * length), GROWTH[1] * length, g.longest)
     return int(math.ceil(asked / g.block) * g.block)
@@ -211,11 +212,11 @@ def adopt(todo, ledger):
     seconds count on."""
     if ledger is None or not ledger.exists():
         return
-    recorded = {(r["group"], r["n"], r["box"], round(r["phi"], 6), r["start"]): r
+    recorded = {(r["group"], r["n"], r["box"], round(r["phi"], 6), r["start"], r["seed"]): r
                 for r in json.loads(ledger.read_text(encoding="utf-8"))["points"]}
     for point in todo:
         g = point.group
-        record = recorded.get((g.name, g.n, g.box, round(point.phi, 6), g.start))
+        record = recorded.get((g.name, g.n, g.box, round(point.phi, 6), g.start, point.seed))
         if record is None or _record(point) is not None or (point.folder / "run.h5").exists():
             continue
         point.folder.mkdir(parents=True, exist_ok=True)
@@ -337,11 +338,10 @@ def _run_on_cluster(todo, cluster, out, partition):
             _report(point, job.result())
 
 
-def simulate(plan, out, jobs, cluster=None, partition=None):
-    """Run every point of ``plan`` until it has no more run to make (:func:`next_length`):
+def simulate(todo, out, jobs, cluster=None, partition=None):
+    """Run every point of ``todo`` until it has no more run to make (:func:`next_length`):
     in this process (``jobs`` 1), in a pool of ``jobs`` processes, or through submitit on
     ``cluster``."""
-    todo = points(plan, out)
     states = [status(p, r, _others(p, todo)) if (r := _record(p)) is not None
               else "not begun" for p in todo]
     print("melting: " + ", ".join(f"{states.count(state)} {state}" for state in
@@ -359,8 +359,8 @@ def simulate(plan, out, jobs, cluster=None, partition=None):
 def summarise(todo, out, results):
     """The tables, the figures, melting.md and melting.json of the points of ``todo`` that
     have a record, each with its :func:`status`."""
-    records = [dict(record, status=status(p, record, _others(p, todo))) for p in todo
-               if (record := _record(p)) is not None]
+    records = [dict(record, status=status(p, record, _others(p, todo)), replicas=p.replicas)
+               for p in todo if (record := _record(p)) is not None]
     measured = [r for r in records if "bPd2" in r]
     results.mkdir(parents=True, exist_ok=True)
     write_tables(measured, results)
@@ -370,7 +370,9 @@ def summarise(todo, out, results):
     draw_bond_order(measured, todo, out, results)
     draw_starts(measured, out, results)
     hours, _ = processor_hours(records)
-    summary = {"points": records, "extrema": found, "cpu_hours": sum(hours.values()),
+    summary = {"points": records, "extrema": found,
+               "replicas": [e for e in estimates(measured) if e["replicas"] > 1],
+               "cpu_hours": sum(hours.values()),
                "plan": [asdict(g) for g in PLAN if g.name in {r["group"] for r in records}],
                "rules": {"drift": DRIFT, "margin": MARGIN, "growth": GROWTH,
                          "production_blocks": PRODUCTION_BLOCKS, "cut": CUT,
@@ -403,15 +405,17 @@ def main(argv=None):
         if unknown:
             parser.error(f"--groups: {', '.join(sorted(unknown))}: no such group; allowed: "
                          + ", ".join(g.name for g in plan))
-        plan = tuple(g for g in plan if g.name in args.groups)
-    adopt(points(plan, args.out), args.ledger or (None if args.quick else LEDGER))
+    # the points of the whole plan, so that a point's replicas are counted in every case
+    todo = [p for p in points(plan, args.out)
+            if not args.groups or p.group.name in args.groups]
+    adopt(todo, args.ledger or (None if args.quick else LEDGER))
     try:
         if not args.report:
-            simulate(plan, args.out, args.jobs, args.cluster, args.partition)
+            simulate(todo, args.out, args.jobs, args.cluster, args.partition)
     except KeyboardInterrupt:
         print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
         return 130
-    summarise(points(plan, args.out), args.out, args.results)
+    summarise(todo, args.out, args.results)
     return 0
 
 

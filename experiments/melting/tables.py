@@ -39,17 +39,43 @@ SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157,
           "data of jellyfysh/HistoricDisks")
 
 
+def estimates(records):
+    """One βP d² per N, box, φ and start: its run's, or over its replicas (runs with other
+    seeds) the weighted mean Σ wᵢ pᵢ / Σ wᵢ, wᵢ = 1/σᵢ², with the error (Σ wᵢ)^(−1/2) (an
+    error not finite makes both NaN); each a dict of n, box, phi, start, seeds, replicas (as
+    many as the plan holds), bPd2, err and status (``done`` when every replica of the plan
+    is, else ``longest`` when every one is done or longest, else ``running``)."""
+    runs = {}
+    for r in records:
+        runs.setdefault((r["n"], r["box"], round(r["phi"], 6), r["start"]), []).append(r)
+    found = []
+    for (n, box, _, start), same in runs.items():
+        sigma = np.array([r["err"] for r in same])
+        w = 1.0 / sigma**2 if np.all(np.isfinite(sigma) & (sigma > 0)) else np.full(
+            len(same), np.nan)
+        states = {r["status"] for r in same} | (
+            {"not begun"} if len(same) < same[0]["replicas"] else set())
+        found.append({"n": n, "box": box, "phi": same[0]["phi"], "start": start,
+                      "seeds": sorted(r["seed"] for r in same),
+                      "replicas": same[0]["replicas"],
+                      "bPd2": float(w @ [r["bPd2"] for r in same] / w.sum()),
+                      "err": float(w.sum() ** -0.5),
+                      "status": "done" if states == {"done"} else
+                      "longest" if states <= {"done", "longest"} else "running"})
+    return found
+
+
 def extrema(records):
     """Per N and box with a loop in its published curve: the published maximum and minimum
     from all its points and from those at our φ only, and ours (:func:`loop_extrema`, one
-    run per φ: the first of its starts in ``STARTS``, the lowest seed), where our points show
-    one. The vertex of a parabola depends on the points fitted: ours compare with the
-    published ones at our φ."""
+    estimate per φ, :func:`estimates`: that of the first of its starts in ``STARTS``), where
+    our points show one. The vertex of a parabola depends on the points fitted: ours
+    compare with the published ones at our φ."""
     found = {}
     for n, box in dict.fromkeys((r["n"], r["box"]) for r in records):
         one = {}
-        for r in sorted((r for r in records if (r["n"], r["box"]) == (n, box)),
-                        key=lambda r: (STARTS.index(r["start"]), r["seed"])):
+        for r in sorted((e for e in estimates(records) if (e["n"], e["box"]) == (n, box)),
+                        key=lambda r: STARTS.index(r["start"])):
             one.setdefault(round(r["phi"], 6), r)
         mine = [one[phi] for phi in sorted(one)]
         phi, pressure, error, _ = reference(n, box)
@@ -65,7 +91,7 @@ def extrema(records):
     return found
 
 
-#: the starts, in the order in which one run per φ is taken for the loop's extrema
+#: the starts, in the order in which one estimate per φ is taken for the loop's extrema
 STARTS = ("compressed", "lattice", "melted")
 
 
@@ -104,21 +130,43 @@ def write_markdown(records, found, results):
                          f"disk, at most {g.longest:.3g})" for g in PLAN) + ".", ""]
     measured = [r for r in records if "bPd2" in r]
     for name in dict.fromkeys(r["group"] for r in measured):
-        rows = sorted((r for r in measured if r["group"] == name), key=lambda r: r["phi"])
+        rows = sorted((r for r in measured if r["group"] == name),
+                      key=lambda r: (r["phi"], r["seed"]))
         phi, pressure, error, _ = reference(rows[0]["n"], rows[0]["box"])
+        seeds = sorted({r["seed"] for r in rows})
         lines += [f"**N = {rows[0]['n']}, box {rows[0]['box']}, {rows[0]['start']} start, "
-                  f"seed {rows[0]['seed']}**",
+                  f"seed{'s' if len(seeds) > 1 else ''} {', '.join(map(str, seeds))}**",
                   "", "| φ | βP d², sim | published | difference / combined error | "
                   "collisions per disk | equilibration cut | drift | ⟨|Ψ₆|⟩ | state |",
                   "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
         for r in rows:
             k = int(np.argmin(np.abs(phi - r["phi"])))
             z = (r["bPd2"] - pressure[k]) / math.hypot(r["err"], error[k])
-            lines.append(f"| {r['phi']:.3f} | {r['bPd2']:.4f} ± {r['err']:.4f} | "
+            which = f" (seed {r['seed']})" if len(seeds) > 1 else ""
+            lines.append(f"| {r['phi']:.3f}{which} | {r['bPd2']:.4f} ± {r['err']:.4f} | "
                          f"{pressure[k]:.4f} ± {error[k]:.4f} | {z:+.1f} | "
                          f"{r['collisions_per_disk']:.3g} | {r['cut']} of "
                          f"{r['cut'] + r['blocks']} blocks | {r['drift']:+.1f} | "
                          f"{r['psi6']:.3f} | {r['status']} |")
+        lines.append("")
+    several = [e for e in estimates(measured) if e["replicas"] > 1]
+    if several:
+        lines += ["**Replicas**: the runs of one state point and start with several seeds, "
+                  "each done at its group's target times √(replicas), their weighted mean "
+                  "(weights 1/σ²) against the published value; running until every "
+                  "replica is done.", "",
+                  "| N, box | φ | start | seeds (runs of replicas) | βP d², sim | published | "
+                  "difference / combined error | state |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for e in several:
+            phi, pressure, error, _ = reference(e["n"], e["box"])
+            k = int(np.argmin(np.abs(phi - e["phi"])))
+            z = (e["bPd2"] - pressure[k]) / math.hypot(e["err"], error[k])
+            lines.append(f"| {e['n']}, {e['box']} | {e['phi']:.3f} | {e['start']} | "
+                         f"{', '.join(map(str, e['seeds']))} ({len(e['seeds'])} of "
+                         f"{e['replicas']}) | {e['bPd2']:.4f} ± "
+                         f"{e['err']:.4f} | {pressure[k]:.4f} ± {error[k]:.4f} | {z:+.1f} | "
+                         f"{e['status']} |")
         lines.append("")
     for r in records:
         if "failed" in r:
