@@ -11,6 +11,7 @@ from matplotlib import pyplot as plt
 from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
 from PIL import Image
+from tables import estimates
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import block_pressures
@@ -27,6 +28,8 @@ TRACED = 16384
 #: g₆(r) in this many bins up to this many diameters
 G6_BINS, G6_REACH = 120, 12.0
 
+#: the colours of the runs of N = 128² from each start, one per seed
+COLOURS = {"compressed": ("C0", "C2", "C4"), "melted": ("C1", "C3", "C5")}
 #: the states of a measured point (study.status) and what the legend says of them
 STATES = {"done": "", "running": ", still running", "longest": ", at its longest run, not done"}
 #: the panels of the equation of state: (N, box) and the groups drawn in each
@@ -47,8 +50,9 @@ def publish(fig, name, out, results):
 
 
 def draw_equation_of_state(records, out, results):
-    """βP d² against φ per N and box: the runs with their blocking errors beside the published
-    curve of the same N and box (and, at N = 128², the large-N curves)."""
+    """βP d² against φ per N and box: the runs with their blocking errors, the replicas of a
+    state point and start as their weighted mean (:func:`tables.estimates`), beside the
+    published curve of the same N and box (and, at N = 128², the large-N curves)."""
     fig, axes = plt.subplots(2, 3, figsize=(12.0, 7.0), constrained_layout=True)
     for ax, (n, box) in zip(axes.ravel(), PANELS, strict=True):
         phi, pressure, error, _ = reference(n, box)
@@ -58,7 +62,7 @@ def draw_equation_of_state(records, out, results):
             for k, (label, source, large, method) in enumerate(LARGE_N):
                 lphi, lp, _, _ = reference(large, "1:1", source, method)
                 ax.plot(lphi, lp, color=f"C{k + 2}", lw=0.8, ls="--", label=label)
-        mine = [r for r in records if r["n"] == n and r["box"] == box]
+        mine = [e for e in estimates(records) if e["n"] == n and e["box"] == box]
         for start, marker, colour in (("compressed", "o", "C0"), ("melted", "s", "C1"),
                                       ("lattice", "^", "C4")):
             for state, caption in STATES.items():
@@ -74,16 +78,19 @@ def draw_equation_of_state(records, out, results):
             lo, hi = min(r["phi"] for r in mine), max(r["phi"] for r in mine)
             inside = (phi >= lo - 0.003) & (phi <= hi + 0.003)
             ax.set_xlim(lo - 0.003, hi + 0.003)
-            span = [*pressure[inside], *(r["bPd2"] for r in mine)]
-            pad = 0.05 * (max(span) - min(span)) + 0.005
-            ax.set_ylim(min(span) - pad, max(span) + pad)
+            span = [*pressure[inside], *(r["bPd2"] - r["err"] for r in mine),
+                    *(r["bPd2"] + r["err"] for r in mine)]
+            low, high = np.nanmin(span), np.nanmax(span)  # an error not yet known: NaN
+            pad = 0.05 * (high - low) + 0.005
+            ax.set_ylim(low - pad, high + pad)
         ax.set_title(f"N = {n}, box {box}", fontsize=10)
         ax.set_xlabel("packing fraction φ")
         ax.set_ylabel("βP d²")
         ax.legend(fontsize=7)
     seeds = ", ".join(str(seed) for seed in sorted({r["seed"] for r in records}))
-    fig.suptitle(f"Hard disks through melting: sim (seed {seeds}, ±1 blocking standard error) "
-                 "against the published pressures (band: ±3 standard errors)", fontsize=10)
+    fig.suptitle(f"Hard disks through melting: sim (seeds {seeds}; replicas as their weighted "
+                 "mean; ±1 blocking standard error) against the published pressures (band: ±3 "
+                 "standard errors)", fontsize=10)
     publish(fig, "melting_eos", out, results)
 
 
@@ -117,8 +124,8 @@ def trace(dataset, n):
 def draw_starts(records, out, results):
     """The runs of N = 128² started both ways at the same φ, as far as they have come (their
     traces, :func:`trace`): βP d² of every block and |Ψ₆| of every snapshot against
-    collisions per disk, the published βP d² beside; so that the two starts are seen to
-    meet."""
+    collisions per disk, the published βP d² beside; so that the two starts, and the
+    replicas of one, are seen to meet."""
     large = [r for r in records if r["n"] == TRACED and "trace" in r]
     twice = sorted({r["phi"] for r in large if r["start"] == "melted"}
                    & {r["phi"] for r in large if r["start"] == "compressed"})
@@ -132,18 +139,19 @@ def draw_starts(records, out, results):
         k = int(np.argmin(np.abs(published[0] - phi)))
         top.axhspan(published[1][k] - 3 * published[2][k], published[1][k] + 3 * published[2][k],
                     color="0.6", alpha=0.4, label="Li et al. 2022 (±3 standard errors)")
-        for r in (r for r in large if r["phi"] == phi):
-            colour = "C0" if r["start"] == "compressed" else "C1"
+        for r in sorted((r for r in large if r["phi"] == phi),
+                        key=lambda r: (r["start"], r["seed"])):
+            colour = COLOURS[r["start"]][r["seed"] % len(COLOURS[r["start"]])]
             top.plot(r["trace"]["block_end"], r["trace"]["block_bPd2"], lw=0.6, color=colour,
-                     label=f"{r['start']} start, each block ({r['status']})")
+                     label=f"{r['start']} start, seed {r['seed']}, each block ({r['status']})")
             bottom.plot(r["trace"]["snapshot"], r["trace"]["psi6"], lw=0.8, color=colour,
-                        label=f"{r['start']} start")
+                        label=f"{r['start']} start, seed {r['seed']}")
         top.set(ylabel="βP d²", title=f"N = 128², φ = {phi:.3f}")
         bottom.set(xlabel="collisions per disk", ylabel="|Ψ₆|")
         top.legend(fontsize=7)
         bottom.legend(fontsize=7)
-    seeds = ", ".join(str(seed) for seed in sorted({r["seed"] for r in large}))
-    fig.suptitle(f"The two starts of N = 128² (seed {seeds})", fontsize=10)
+    fig.suptitle("The two starts of N = 128², and the replicas of one (other seeds)",
+                 fontsize=10)
     publish(fig, "melting_starts", out, results)
 
 
@@ -160,7 +168,8 @@ def draw_bond_order(records, todo, out, results):
     for r in sorted(large, key=lambda r: (r["start"], r["phi"])):
         right.loglog(r["trace"]["r"], r["trace"]["g6"], lw=1.0,
                      ls="-" if r["start"] == "compressed" else ":",
-                     label=f"φ = {r['phi']:.3f}, {r['start']}")
+                     label=f"φ = {r['phi']:.3f}, {r['start']}"
+                           + (f", seed {r['seed']}" if r["seed"] else ""))
     x = np.array([1.0, G6_REACH])
     right.loglog(x, x ** -0.25, color="k", lw=0.8, ls="--",
                  label="r^(−1/4), the slowest decay of a hexatic (KTHNY)")
