@@ -2,37 +2,39 @@
 at the sizes and in the boxes of the published references, each point run until its error
 reaches its group's target.
 
-Every state point of ``PLAN`` is one run of the ``melting`` scene in a folder of its own
-under ``--out`` (``runs/<group>-<φ>/run.h5``), which also keeps the point's analysis
-(``point.json``) and the processor seconds it took (``cpu_seconds``). A point is run in
-rounds: the first runs ``first`` collisions per disk; after each,
-:func:`sim.analysis.equation_of_state.run_pressure` drops the equilibration blocks by the
-MSER rule and finds the blocking error of the rest, and the point is done when that error
-is at most the group's ``target``, the blocking has converged, the means of the
-production's two halves agree within ``DRIFT`` standard errors, ``PRODUCTION_BLOCKS``
-blocks are kept and the cut is at most a share ``CUT`` of the blocks. Otherwise it is
-resumed to the length its error asks for (:func:`next_length`), at most ``longest``
-collisions per disk; a point that reaches it stays as it is, its error in the tables. The
-runs go to a pool of ``--jobs`` worker processes, the longest first, each point given its
-next run as soon as one ends; or with ``--cluster slurm``, in rounds of jobs, to SLURM
-through submitit.
+Every point of ``PLAN`` (a state point, start and seed) is one run of the ``melting`` scene
+in a folder of its own under ``--out`` (``runs/<group>-<φ>/run.h5``, ``-seed<s>`` after the
+φ but for seed 0), which also keeps the point's analysis (``point.json``) and the processor
+seconds it took (``cpu_seconds``). A point is run in rounds: the first runs ``first``
+collisions per disk; after each, :func:`sim.analysis.equation_of_state.run_pressure` drops
+the equilibration blocks by the MSER rule and finds the blocking error of the rest, and the
+point is done when that error is at most its target (the group's, times √(replicas):
+``plan.Point.target``), the blocking has converged, the means of the production's two halves
+agree within ``DRIFT`` standard errors, ``PRODUCTION_BLOCKS`` blocks are kept and the cut is
+at most a share ``CUT`` of the blocks. Otherwise it is resumed to the length its error asks
+for (:func:`next_length`), at most ``longest`` collisions per disk; a point that reaches it
+stays as it is, its error in the tables. The runs go to a pool of ``--jobs`` worker
+processes, the longest first, each point given its next run as soon as one ends; or with
+``--cluster slurm``, in rounds of jobs, to SLURM through submitit.
 
 Interrupted (Ctrl-C, a killed job, the end of a session), the study starts again where it
 was: a run resumes from its last checkpoint (written every 30 s of wall time and at every
 stop), a finished point is not run again, and a second ``make melting`` with every point done
 only reads the analyses and draws.
 
-Writes into ``--results`` (default outputs/melting/results; ``make melting`` copies them into
-docs/results/): ``melting.csv`` (one row per run: n, aspect, phi, start,
+Writes into ``--results`` (default outputs/melting/results; ``make melting`` copies them
+into docs/results/): ``melting.csv`` (one row per run: n, aspect, phi, start, seed,
 collisions_per_disk, bPd2, err, psi6), ``melting_reference.csv`` (the published value of
 each row's N, box and φ with its source), ``melting.md`` (the runs against the published
-values, the loops' extrema, the processor hours), ``melting.json`` (per point the whole
-analysis and processor seconds; per group the published loop's extrema and ours),
-``melting_eos.png``, ``melting_psi6.png`` and ``melting_starts.png`` (web versions; the full
-figures, PNG and PDF, in ``--out``/figures).
+values, the replicas' weighted means, the loops' extrema, the processor hours),
+``melting.json`` (per point the whole analysis and processor seconds; the replicas' weighted
+means; per group the published loop's extrema and ours), ``melting_eos.png``,
+``melting_psi6.png`` and ``melting_starts.png`` (web versions; the full figures, PNG and
+PDF, in ``--out``/figures).
 
 The study's other modules: ``plan.py`` (the groups, the rules' numbers, the points),
-``tables.py`` (the tables, the loops' extrema, melting.md) and ``figures.py``.
+``tables.py`` (the tables, the replicas' weighted means, the loops' extrema, melting.md) and
+``figures.py``.
 
     python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--quick] [--report]
 """

@@ -1,6 +1,6 @@
 """The melting study's results as data: the tables (melting.csv, melting_reference.csv), the
-loops' extrema, melting.md with every run against its published value, and files written
-whole."""
+replicas' weighted means, the loops' extrema, melting.md with every run against its published
+value, and files written whole."""
 
 import csv
 import math
