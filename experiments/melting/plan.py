@@ -64,9 +64,10 @@ class Group:
 #: published value (N = 72 in its lattice box at φ = 0.696; N = 224 at 0.720, whose
 #: compressed fluid froze into one crystal that the run never left, its blocking error ten
 #: times below the published one), or where one run would need more hours than a job holds
-#: (N = 128² at 0.716 from the compressed start, about five on one core): replicas, run side
-#: by side, whose weighted mean is the state point's pressure (:func:`tables.estimates`)
-#: once they agree (``AGREEMENT``)
+#: (N = 128² at 0.716 from the compressed start, about six on one core at 1.6·10⁶ collisions
+#: per second; each of its four replicas about two): replicas, run side by side, whose
+#: weighted mean is the state point's pressure (:func:`tables.estimates`) once they agree
+#: (``AGREEMENT``)
 PLAN = (
     Group("72-square", 72, "1:1", (0.650, 0.660, 0.670, 0.680, 0.686, 0.690, 0.694, 0.698,
                                    0.702, 0.706, 0.710, 0.720),
@@ -92,7 +93,7 @@ PLAN = (
     Group("16384-square", 16384, "1:1", (0.698, 0.704, 0.708, 0.712, 0.716),
           "compressed", 1000, 80_000, 3_200_000, 0.003),
     Group("16384-square-replicas", 16384, "1:1", (0.716,),
-          "compressed", 1000, 80_000, 3_200_000, 0.003, seeds=(1, 2)),
+          "compressed", 1000, 80_000, 3_200_000, 0.003, seeds=(1, 2, 3, 4)),
     Group("16384-square-melted", 16384, "1:1", (0.704, 0.716),
           "melted", 1000, 80_000, 3_200_000, 0.003),
 )
