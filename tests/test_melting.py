@@ -235,3 +235,27 @@ def test_replicas_combine_to_their_weighted_mean():
     assert first["status"] == "running" and first["bPd2"] == 9.0
     both = tables.estimates([records[0], dict(records[1], status="longest")])[0]
     assert both["status"] == "longest"
+
+
+def test_a_replica_still_on_its_way_does_not_undo_a_run_done(tmp_path):
+    """study._others: a replica begun later, its blocks still too few, counts against no run
+    of its state point, however far its pressure; once it meets its own target and
+    disagrees, the run done runs on."""
+    study = _study()
+    plan = sys.modules["plan"]
+    todo = plan.points(plan.PLAN, tmp_path)
+    by_folder = {p.folder.name: p for p in todo}
+    first = by_folder["16384-square-0.716"]
+    later = by_folder["16384-square-replicas-0.716-seed1"]
+    done = {"collisions_per_disk": 1_200_000, "bPd2": 9.16, "err": 0.0043, "converged": True,
+            "drift": 0.0, "blocks": 1190, "cut": 9}
+    early = dict(done, collisions_per_disk=80_000, bPd2=9.12, err=0.005, blocks=42, cut=38)
+    for point, record in ((first, done), (later, early)):
+        point.folder.mkdir(parents=True)
+        (point.folder / "point.json").write_text(json.dumps(record))
+    assert study._others(first, todo) == []
+    assert study.status(first, done, study._others(first, todo)) == "done"
+    finished = dict(early, blocks=400, cut=10)  # met its own target, 8 combined errors off
+    (later.folder / "point.json").write_text(json.dumps(finished))
+    assert study._others(first, todo) == [finished]
+    assert study.status(first, done, study._others(first, todo)) == "running"

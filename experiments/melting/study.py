@@ -99,14 +99,15 @@ def reached(point, record):
 
 def agrees(record, others):
     """Whether the run's βP d² agrees with that of every run of the same state point from
-    another start (``others``: their records) within ``AGREEMENT`` combined errors."""
+    another start or with another seed (``others``: their records, :func:`_others`) within
+    ``AGREEMENT`` combined errors."""
     return all(abs(record["bPd2"] - other["bPd2"])
                <= AGREEMENT * math.hypot(record["err"], other["err"])
                for other in others if "bPd2" in other)
 
 
 def status(point, record, others=()):
-    """``done`` (its target met, and its βP d² that of the runs from other starts,
+    """``done`` (its target met, and its βP d² that of the runs from other starts or seeds,
     ``others``: their records), ``longest`` (run to its group's longest, not done),
     ``failed`` (the reason in its record) or ``running``."""
     if "failed" in record:
@@ -117,8 +118,12 @@ def status(point, record, others=()):
 
 
 def _others(point, todo):
-    """The records of ``point``'s twins (:func:`plan.twins`) in ``todo``."""
-    return [r for twin in twins(point, todo) if (r := _record(twin)) is not None]
+    """The records of ``point``'s twins (:func:`plan.twins`) in ``todo`` that are finished on
+    their own: their target met (:func:`reached`) or their longest run made. A twin still on
+    its way, such as a replica begun later and still equilibrating, counts against no run."""
+    return [r for twin in twins(point, todo) if (r := _record(twin)) is not None
+            and "bPd2" in r and (reached(twin, r)
+                                 or r["collisions_per_disk"] >= twin.group.longest)]
 
 
 def next_length(point, record, others=()):
