@@ -215,7 +215,8 @@ def test_the_runs_of_one_state_point_from_other_starts_or_seeds_are_its_twins():
 
 def test_replicas_combine_to_their_weighted_mean():
     """tables.estimates: the runs of one N, box, φ and start with different seeds give
-    Σ p/σ² / Σ 1/σ² ± (Σ 1/σ²)^(−1/2), done only when each replica of the plan is; a run
+    Σ p/σ² / Σ 1/σ² ± S (Σ 1/σ²)^(−1/2), S the Particle Data Group's scale factor when they
+    scatter more than their errors say, done only when each replica of the plan is; a run
     alone is itself."""
     _study()
     tables = sys.modules["tables"]
@@ -227,7 +228,11 @@ def test_replicas_combine_to_their_weighted_mean():
     w = np.array([1 / 0.003**2, 1 / 0.004**2])
     assert both["seeds"] == [0, 1] and both["status"] == "running"
     assert both["bPd2"] == pytest.approx((9.0 * w[0] + 9.1 * w[1]) / w.sum())
-    assert both["err"] == pytest.approx(0.0024)  # 0.003 · 0.004 / 0.005
+    chi2 = w @ (np.array([9.0, 9.1]) - both["bPd2"]) ** 2  # 0.1² / 0.005² = 400: scaled
+    assert both["scale"] == pytest.approx(chi2**0.5) == pytest.approx(20.0)
+    assert both["err"] == pytest.approx(0.0024 * 20.0)  # 0.003 · 0.004 / 0.005, widened
+    close = tables.estimates([records[0], dict(records[1], bPd2=9.001)])[0]
+    assert close["scale"] == 1.0 and close["err"] == pytest.approx(0.0024)
     assert (alone["bPd2"], alone["err"], alone["status"]) == (8.7, 0.01, "done")
     unknown = tables.estimates([records[0], dict(records[1], err=float("nan"))])[0]
     assert np.isnan(unknown["bPd2"]) and np.isnan(unknown["err"])

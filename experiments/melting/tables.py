@@ -41,25 +41,33 @@ SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157,
 
 def estimates(records):
     """One βP d² per N, box, φ and start: its run's, or over its replicas (runs with other
-    seeds) the weighted mean Σ wᵢ pᵢ / Σ wᵢ, wᵢ = 1/σᵢ², with the error (Σ wᵢ)^(−1/2) (an
-    error not finite makes both NaN); each a dict of n, box, phi, start, seeds, replicas (as
-    many as the plan holds), bPd2, err and status (``done`` when every replica of the plan
-    is, else ``longest`` when every one is done or longest, else ``running``)."""
+    seeds) the weighted mean p̄ = Σ wᵢ pᵢ / Σ wᵢ, wᵢ = 1/σᵢ², with the error
+    S (Σ wᵢ)^(−1/2), S = max(1, √(χ²/(k − 1))), χ² = Σ wᵢ (pᵢ − p̄)² over the k replicas:
+    the scale factor of the Particle Data Group's averages (Review of Particle Physics,
+    Introduction), which widens the error when the replicas scatter more than their own
+    errors say, as short runs whose blocking has not seen the slowest fluctuations do. An
+    error not finite makes the mean and the error NaN. Each a dict of n, box, phi, start,
+    seeds, replicas (as many as the plan holds), bPd2, err, scale (S) and status (``done``
+    when every replica of the plan is, else ``longest`` when every one is done or longest,
+    else ``running``)."""
     runs = {}
     for r in records:
         runs.setdefault((r["n"], r["box"], round(r["phi"], 6), r["start"]), []).append(r)
     found = []
     for (n, box, _, start), same in runs.items():
+        p = np.array([r["bPd2"] for r in same])
         sigma = np.array([r["err"] for r in same])
         w = 1.0 / sigma**2 if np.all(np.isfinite(sigma) & (sigma > 0)) else np.full(
             len(same), np.nan)
+        mean = w @ p / w.sum()
+        chi2 = w @ (p - mean) ** 2
+        scale = max(1.0, math.sqrt(chi2 / (len(same) - 1))) if len(same) > 1 else 1.0
         states = {r["status"] for r in same} | (
             {"not begun"} if len(same) < same[0]["replicas"] else set())
         found.append({"n": n, "box": box, "phi": same[0]["phi"], "start": start,
                       "seeds": sorted(r["seed"] for r in same),
-                      "replicas": same[0]["replicas"],
-                      "bPd2": float(w @ [r["bPd2"] for r in same] / w.sum()),
-                      "err": float(w.sum() ** -0.5),
+                      "replicas": same[0]["replicas"], "bPd2": float(mean),
+                      "err": float(scale * w.sum() ** -0.5), "scale": float(scale),
                       "status": "done" if states == {"done"} else
                       "longest" if states <= {"done", "longest"} else "running"})
     return found
@@ -154,11 +162,12 @@ def write_markdown(records, found, results):
     if several:
         lines += ["**Replicas**: the runs of one state point and start with several seeds, "
                   "each done at its group's target times √(replicas), their weighted mean "
-                  "(weights 1/σ²) against the published value; running until every "
-                  "replica is done.", "",
-                  "| N, box | φ | start | seeds (runs of replicas) | βP d², sim | published | "
-                  "difference / combined error | state |",
-                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+                  "(weights 1/σ²) against the published value, its error widened by the "
+                  "scale factor S = max(1, √(χ²/(k − 1))) when the replicas scatter more "
+                  "than their errors say; running until every replica is done.", "",
+                  "| N, box | φ | start | seeds (runs of replicas) | βP d², sim | S | "
+                  "published | difference / combined error | state |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
         for e in several:
             phi, pressure, error, _ = reference(e["n"], e["box"])
             k = int(np.argmin(np.abs(phi - e["phi"])))
@@ -166,8 +175,8 @@ def write_markdown(records, found, results):
             lines.append(f"| {e['n']}, {e['box']} | {e['phi']:.3f} | {e['start']} | "
                          f"{', '.join(map(str, e['seeds']))} ({len(e['seeds'])} of "
                          f"{e['replicas']}) | {e['bPd2']:.4f} ± "
-                         f"{e['err']:.4f} | {pressure[k]:.4f} ± {error[k]:.4f} | {z:+.1f} | "
-                         f"{e['status']} |")
+                         f"{e['err']:.4f} | {e['scale']:.2f} | {pressure[k]:.4f} ± "
+                         f"{error[k]:.4f} | {z:+.1f} | {e['status']} |")
         lines.append("")
     for r in records:
         if "failed" in r:
