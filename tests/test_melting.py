@@ -264,3 +264,21 @@ def test_a_replica_still_on_its_way_does_not_undo_a_run_done(tmp_path):
     (later.folder / "point.json").write_text(json.dumps(finished))
     assert study._others(first, todo) == [finished]
     assert study.status(first, done, study._others(first, todo)) == "running"
+
+
+@pytest.mark.parametrize("shortest_first, expected", [(False, [2, 0, 1]), (True, [1, 0, 2])])
+def test_rounds_are_handed_out_the_longest_or_the_shortest_first(monkeypatch, shortest_first,
+                                                                 expected):
+    """study._run_here in the order of study.urgency: the costliest round (disks times
+    collisions per disk) first, or with shortest_first the cheapest."""
+    study = _study()
+    plan = sys.modules["plan"]
+    points = {p.folder.name: p for p in plan.points(plan.PLAN, Path("unused"))}
+    rounds = [(points["72-square-0.650"], 2_000_000), (points["224-square-0.670"], 300_000),
+              (points["16384-square-0.698"], 80_000)]  # 1.44e8, 6.72e7, 1.31e9 collisions
+    done = []
+    monkeypatch.setattr(study, "_pending", lambda todo: [r for r in rounds if r not in done])
+    monkeypatch.setattr(study, "advance", lambda point, length: done.append((point, length)))
+    monkeypatch.setattr(study, "_report", lambda *args: None)
+    study._run_here([], study.urgency(shortest_first))
+    assert done == [rounds[k] for k in expected]

@@ -14,8 +14,9 @@ agree within ``DRIFT`` standard errors, ``PRODUCTION_BLOCKS`` blocks are kept an
 at most a share ``CUT`` of the blocks. Otherwise it is resumed to the length its error asks
 for (:func:`next_length`), at most ``longest`` collisions per disk; a point that reaches it
 stays as it is, its error in the tables. The runs go to a pool of ``--jobs`` worker
-processes, the longest first, each point given its next run as soon as one ends; or with
-``--cluster slurm``, in rounds of jobs, to SLURM through submitit.
+processes, the longest first (``--shortest-first``: the shortest), each point given its next
+run as soon as one ends; or with ``--cluster slurm``, in rounds of jobs, to SLURM through
+submitit.
 
 Interrupted (Ctrl-C, a killed job, the end of a session), the study starts again where it
 was: a run resumes from its last checkpoint (written every 30 s of wall time and at every
@@ -36,7 +37,8 @@ The study's other modules: ``plan.py`` (the groups, the rules' numbers, the poin
 ``tables.py`` (the tables, the replicas' weighted means, the loops' extrema, melting.md) and
 ``figures.py``.
 
-    python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--quick] [--report]
+    python experiments/melting/study.py [--groups 72-square …] [--jobs 2] [--shortest-first]
+                                        [--quick] [--report]
 """
 
 import argparse
@@ -269,6 +271,13 @@ def _cost_of(round_):
     return point.group.n * collisions_per_disk
 
 
+def urgency(shortest_first=False):
+    """The key whose largest round is handed out next: its cost in collisions, the longest
+    first, which ends a pool of rounds soonest; or with ``shortest_first`` its negative, the
+    shortest first, which ends as many rounds as can be in a job of a few hours."""
+    return (lambda round_: -_cost_of(round_)) if shortest_first else _cost_of
+
+
 def _report(point, record, others):
     print(f"melting: {point.folder.name} at {record['collisions_per_disk']:.3g} collisions "
           f"per disk: " + (f"βP d² = {record['bPd2']:.4f} ± {record['err']:.4f}, "
@@ -276,26 +285,26 @@ def _report(point, record, others):
                            else f"failed: {record['failed']}"), flush=True)
 
 
-def _run_here(todo):
-    """Every point's rounds in this process, the longest first."""
+def _run_here(todo, key):
+    """Every point's rounds in this process, in the order of ``key`` (:func:`urgency`)."""
     while rounds := _pending(todo):
-        point, collisions_per_disk = max(rounds, key=_cost_of)
+        point, collisions_per_disk = max(rounds, key=key)
         _report(point, advance(point, collisions_per_disk), _others(point, todo))
 
 
-def _run_in_pool(todo, jobs):
-    """Every point's rounds in ``jobs`` worker processes (spawned: the engine compiles in
-    each, from numba's cache), the longest first; a point whose round ends is given its
-    next at once, and no more runs are handed out than there are workers. Stopped by
-    SIGINT or SIGTERM (to this process alone or to its group), it asks its workers to stop
-    their runs, which write their checkpoints, and raises KeyboardInterrupt."""
+def _run_in_pool(todo, jobs, key):
+    """Every point's rounds in ``jobs`` worker processes (spawned: the engine compiles in each,
+    from numba's cache), in the order of ``key`` (:func:`urgency`); a point whose round ends
+    is given its next at once, and no more runs are handed out than there are workers.
+    Stopped by SIGINT or SIGTERM (to this process alone or to its group), it asks its
+    workers to stop their runs, which write their checkpoints, and raises KeyboardInterrupt."""
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from multiprocessing import active_children, get_context
 
     def stop(signum, frame):
         raise KeyboardInterrupt
 
-    waiting = sorted(_pending(todo), key=_cost_of)
+    waiting = sorted(_pending(todo), key=key)
     previous = signal.signal(signal.SIGTERM, stop)
     try:
         with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
@@ -319,7 +328,7 @@ def _run_in_pool(todo, jobs):
                             length = next_length(again, last, _others(again, todo))
                             if length is not None:
                                 waiting.append((again, length))
-                        waiting.sort(key=_cost_of)
+                        waiting.sort(key=key)
             except KeyboardInterrupt:
                 for worker in active_children():  # each run stops at its next chunk
                     os.kill(worker.pid, signal.SIGINT)
@@ -345,10 +354,10 @@ def _run_on_cluster(todo, cluster, out, partition):
             _report(point, job.result())
 
 
-def simulate(todo, out, jobs, cluster=None, partition=None):
+def simulate(todo, out, jobs, cluster=None, partition=None, shortest_first=False):
     """Run every point of ``todo`` until it has no more run to make (:func:`next_length`):
-    in this process (``jobs`` 1), in a pool of ``jobs`` processes, or through submitit on
-    ``cluster``."""
+    in this process (``jobs`` 1), in a pool of ``jobs`` processes, the longest rounds first
+    or the shortest (:func:`urgency`), or through submitit on ``cluster``."""
     states = [status(p, r, _others(p, todo)) if (r := _record(p)) is not None
               else "not begun" for p in todo]
     print("melting: " + ", ".join(f"{states.count(state)} {state}" for state in
@@ -358,9 +367,9 @@ def simulate(todo, out, jobs, cluster=None, partition=None):
     if cluster is not None:
         _run_on_cluster(todo, cluster, out, partition)
     elif jobs == 1:
-        _run_here(todo)
+        _run_here(todo, urgency(shortest_first))
     else:
-        _run_in_pool(todo, jobs)
+        _run_in_pool(todo, jobs, urgency(shortest_first))
 
 
 def summarise(todo, out, results):
@@ -399,6 +408,9 @@ def main(argv=None):
     parser.add_argument("--cluster", choices=("slurm", "local"), default=None,
                         help="run the rounds through submitit instead of joblib")
     parser.add_argument("--partition", default=None, help="the SLURM partition of the jobs")
+    parser.add_argument("--shortest-first", action="store_true",
+                        help="hand out the shortest rounds first, not the longest: as many "
+                             "rounds finished as can be in a few hours")
     parser.add_argument("--quick", action="store_true", help="a smoke run: two short points")
     parser.add_argument("--report", action="store_true",
                         help="run nothing: the results of the points done so far")
@@ -418,7 +430,8 @@ def main(argv=None):
     adopt(todo, args.ledger or (None if args.quick else LEDGER))
     try:
         if not args.report:
-            simulate(todo, args.out, args.jobs, args.cluster, args.partition)
+            simulate(todo, args.out, args.jobs, args.cluster, args.partition,
+                     args.shortest_first)
     except KeyboardInterrupt:
         print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
         return 130
