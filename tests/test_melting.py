@@ -282,3 +282,32 @@ def test_rounds_are_handed_out_the_longest_or_the_shortest_first(monkeypatch, sh
     monkeypatch.setattr(study, "_report", lambda *args: None)
     study._run_here([], study.urgency(shortest_first))
     assert done == [rounds[k] for k in expected]
+
+
+def test_replicas_that_scatter_more_than_their_errors_run_on(tmp_path):
+    """study.status and next_length with the replicas' scale factor: two runs of one state
+    point and start, each within its own target, 2.7 combined errors apart, have not sampled
+    what their errors claim (S ≈ 2.7) and both run on; close together, both are done."""
+    study = _study()
+    plan = sys.modules["plan"]
+    todo = plan.points(plan.PLAN, tmp_path)
+    by_folder = {p.folder.name: p for p in todo}
+    first = by_folder["16384-square-0.716"]
+    later = by_folder["16384-square-replicas-0.716-seed1"]
+    long = {"start": "compressed", "seed": 0, "collisions_per_disk": 1_200_000,
+            "bPd2": 9.1619, "err": 0.0043, "converged": True, "drift": 0.0, "blocks": 1190,
+            "cut": 9}
+    short = dict(long, seed=1, collisions_per_disk=240_000, bPd2=9.1419, err=0.0061,
+                 blocks=235, cut=5)
+    for point, record in ((first, long), (later, short)):
+        point.folder.mkdir(parents=True)
+        (point.folder / "point.json").write_text(json.dumps(record))
+    assert study._scale(first, long, study._others(first, todo)) == pytest.approx(2.68, abs=0.01)
+    for point, record in ((first, long), (later, short)):
+        others = study._others(point, todo)
+        assert study.status(point, record, others) == "running"
+        assert study.next_length(point, record, others) > record["collisions_per_disk"]
+    close = dict(short, bPd2=9.1600)
+    (later.folder / "point.json").write_text(json.dumps(close))
+    assert study.status(first, long, study._others(first, todo)) == "done"
+    assert study.status(later, close, study._others(later, todo)) == "done"

@@ -65,7 +65,14 @@ from plan import (
     points,
     twins,
 )
-from tables import estimates, extrema, processor_hours, write_markdown, write_tables
+from tables import (
+    estimates,
+    extrema,
+    processor_hours,
+    scale_factor,
+    write_markdown,
+    write_tables,
+)
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
@@ -90,11 +97,11 @@ def _record(point):
     return json.loads(path.read_text()) if path.exists() else None
 
 
-def reached(point, record):
-    """Whether the point's run meets its target (:attr:`plan.Point.target`): error,
-    convergence, no drift and ``PRODUCTION_BLOCKS`` blocks kept, at most a share ``CUT`` of
-    the blocks cut."""
-    return (record["err"] <= point.target and record["converged"]
+def reached(point, record, scale=1.0):
+    """Whether the point's run meets its target (:attr:`plan.Point.target`): error (times
+    ``scale``, :func:`_scale`), convergence, no drift and ``PRODUCTION_BLOCKS`` blocks kept,
+    at most a share ``CUT`` of the blocks cut."""
+    return (record["err"] * scale <= point.target and record["converged"]
             and abs(record["drift"]) < DRIFT and record["blocks"] >= PRODUCTION_BLOCKS
             and record["cut"] <= CUT * (record["cut"] + record["blocks"]))
 
@@ -108,13 +115,23 @@ def agrees(record, others):
                for other in others if "bPd2" in other)
 
 
+def _scale(point, record, others):
+    """The scale factor S (:func:`tables.scale_factor`) of the run and its replicas among
+    ``others`` (the same start, other seeds): 1 without any. Replicas that scatter more than
+    their errors say have not yet sampled what their errors claim, short runs whose blocking
+    missed the slowest fluctuations, and each runs on until S times its error meets its
+    target."""
+    same = [other for other in others if other.get("start") == point.group.start]
+    return scale_factor([record, *same]) if same else 1.0
+
+
 def status(point, record, others=()):
-    """``done`` (its target met, and its βP d² that of the runs from other starts or seeds,
-    ``others``: their records), ``longest`` (run to its group's longest, not done),
-    ``failed`` (the reason in its record) or ``running``."""
+    """``done`` (its target met, with its replicas' scale factor, and its βP d² that of the
+    runs from other starts or seeds, ``others``: their records), ``longest`` (run to its
+    group's longest, not done), ``failed`` (the reason in its record) or ``running``."""
     if "failed" in record:
         return "failed"
-    if reached(point, record) and agrees(record, others):
+    if reached(point, record, _scale(point, record, others)) and agrees(record, others):
         return "done"
     return "longest" if record["collisions_per_disk"] >= point.group.longest else "running"
 
@@ -130,7 +147,8 @@ def _others(point, todo):
 
 def next_length(point, record, others=()):
     """Collisions per disk the point runs to in its next round, or None when it has none
-    (:func:`status` other than ``running``): the length its error asks for, to ``MARGIN``,
+    (:func:`status` other than ``running``): the length its error (times its replicas' scale
+    factor, :func:`_scale`) asks for, to ``MARGIN``,
     from ``GROWTH`` [0] to [1] times its length so far, at most its group's longest, a
     whole number of blocks."""
     g = point.group
@@ -138,7 +156,8 @@ def next_length(point, record, others=()):
         return None
     length = record["collisions_per_disk"]
     production = length * record["blocks"] / (record["blocks"] + record["cut"])
-    ratio = (record["err"] / point.target) ** 2 if math.isfinite(record["err"]) else math.inf
+    error = record["err"] * _scale(point, record, others)
+    ratio = (error / point.target) ** 2 if math.isfinite(error) else math.inf
     asked = length - production + max(production * MARGIN * ratio, PRODUCTION_BLOCKS * g.block)
     asked = min(max(asked, GROWTH[0] * length), GROWTH[1] * length, g.longest)
     return int(math.ceil(asked / g.block) * g.block)

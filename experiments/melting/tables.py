@@ -39,6 +39,25 @@ SOURCE = ("Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, J. Chem. Phys. 157,
           "data of jellyfysh/HistoricDisks")
 
 
+def _weighted(runs):
+    """The weighted mean p̄ of the runs' βP d², their weights 1/σᵢ² and the scale factor S
+    (:func:`estimates`); NaN for an error not finite."""
+    p = np.array([r["bPd2"] for r in runs])
+    sigma = np.array([r["err"] for r in runs])
+    w = 1.0 / sigma**2 if np.all(np.isfinite(sigma) & (sigma > 0)) else np.full(len(runs),
+                                                                                  np.nan)
+    mean = w @ p / w.sum()
+    chi2 = w @ (p - mean) ** 2
+    return mean, w, max(1.0, math.sqrt(chi2 / (len(runs) - 1))) if len(runs) > 1 else 1.0
+
+
+def scale_factor(runs):
+    """The scale factor S of the runs' βP d² (records with bPd2 and err, :func:`estimates`):
+    1 for one run, NaN for an error not finite."""
+    mean, _, scale = _weighted(runs)
+    return scale if np.isfinite(mean) else math.nan
+
+
 def estimates(records):
     """One βP d² per N, box, φ and start: its run's, or over its replicas (runs with other
     seeds) the weighted mean p̄ = Σ wᵢ pᵢ / Σ wᵢ, wᵢ = 1/σᵢ², with the error
@@ -55,13 +74,7 @@ def estimates(records):
         runs.setdefault((r["n"], r["box"], round(r["phi"], 6), r["start"]), []).append(r)
     found = []
     for (n, box, _, start), same in runs.items():
-        p = np.array([r["bPd2"] for r in same])
-        sigma = np.array([r["err"] for r in same])
-        w = 1.0 / sigma**2 if np.all(np.isfinite(sigma) & (sigma > 0)) else np.full(
-            len(same), np.nan)
-        mean = w @ p / w.sum()
-        chi2 = w @ (p - mean) ** 2
-        scale = max(1.0, math.sqrt(chi2 / (len(same) - 1))) if len(same) > 1 else 1.0
+        mean, w, scale = _weighted(same)
         states = {r["status"] for r in same} | (
             {"not begun"} if len(same) < same[0]["replicas"] else set())
         found.append({"n": n, "box": box, "phi": same[0]["phi"], "start": start,
@@ -124,8 +137,9 @@ def _extreme(e):
 def write_markdown(records, found, results):
     """melting.md: every run against the published value of its N and box, with its state,
     the loops' extrema, the processor hours."""
-    lines = [f"A point is done when the blocking error of βP d² over its production is at "
-             f"most its group's target, the blocking has converged, the means of the "
+    lines = [f"A point is done when the blocking error of βP d² over its production (with "
+             f"replicas, times their scale factor S) is at most its target (its group's, "
+             f"times √(replicas)), the blocking has converged, the means of the "
              f"production's halves differ by less than {DRIFT:g} standard errors, at "
              f"least {PRODUCTION_BLOCKS} blocks are kept, at most {CUT:.0%} of the blocks "
              f"are cut as equilibration (a longer cut is a transient the run is too short "
@@ -164,7 +178,8 @@ def write_markdown(records, found, results):
                   "each done at its group's target times √(replicas), their weighted mean "
                   "(weights 1/σ²) against the published value, its error widened by the "
                   "scale factor S = max(1, √(χ²/(k − 1))) when the replicas scatter more "
-                  "than their errors say; running until every replica is done.", "",
+                  "than their errors say, and each replica runs on until S times its error "
+                  "meets its target; running until every replica is done.", "",
                   "| N, box | φ | start | seeds (runs of replicas) | βP d², sim | S | "
                   "published | difference / combined error | state |",
                   "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
