@@ -29,7 +29,7 @@ TRACED = 16384
 G6_BINS, G6_REACH = 120, 12.0
 
 #: the colours of the runs of N = 128² from each start, one per seed
-COLOURS = {"compressed": ("C0", "C2", "C4"), "melted": ("C1", "C3", "C5")}
+COLOURS = {"compressed": ("C0", "C2", "C4", "C6", "C8"), "melted": ("C1", "C3", "C5", "C7", "C9")}
 #: the states of a measured point (study.status) and what the legend says of them
 STATES = {"done": "", "running": ", still running", "longest": ", at its longest run, not done"}
 #: the panels of the equation of state: (N, box) and the groups drawn in each
