@@ -89,7 +89,7 @@ def draw_equation_of_state(records, out, results):
         ax.legend(fontsize=7)
     seeds = ", ".join(str(seed) for seed in sorted({r["seed"] for r in records}))
     fig.suptitle(f"Hard disks through melting: sim (seeds {seeds}; replicas as their weighted "
-                 "mean; ±1 blocking standard error) against the published pressures (band: ±3 "
+                 "mean; ±1 blocking standard error)\nagainst the published pressures (band: ±3 "
                  "standard errors)", fontsize=10)
     publish(fig, "melting_eos", out, results)
 
