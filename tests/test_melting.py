@@ -242,22 +242,29 @@ def test_replicas_combine_to_their_weighted_mean():
     assert both["status"] == "longest"
 
 
-def test_a_replica_still_on_its_way_does_not_undo_a_run_done(tmp_path):
-    """study._others: a replica begun later, its blocks still too few, counts against no run
-    of its state point, however far its pressure; once it meets its own target and
-    disagrees, the run done runs on."""
+def _seed_and_replica(tmp_path, first_record, later_record):
+    """The study, the points of the plan under ``tmp_path``, and N = 128² at φ = 0.716 from
+    the compressed fluid with seed 0 and seed 1, their records written."""
     study = _study()
     plan = sys.modules["plan"]
     todo = plan.points(plan.PLAN, tmp_path)
     by_folder = {p.folder.name: p for p in todo}
     first = by_folder["16384-square-0.716"]
     later = by_folder["16384-square-replicas-0.716-seed1"]
+    for point, record in ((first, first_record), (later, later_record)):
+        point.folder.mkdir(parents=True)
+        (point.folder / "point.json").write_text(json.dumps(record))
+    return study, todo, first, later
+
+
+def test_a_replica_still_on_its_way_does_not_undo_a_run_done(tmp_path):
+    """study._others: a replica begun later, its blocks still too few, counts against no run
+    of its state point, however far its pressure; once it meets its own target and
+    disagrees, the run done runs on."""
     done = {"collisions_per_disk": 1_200_000, "bPd2": 9.16, "err": 0.0043, "converged": True,
             "drift": 0.0, "blocks": 1190, "cut": 9}
     early = dict(done, collisions_per_disk=80_000, bPd2=9.12, err=0.005, blocks=42, cut=38)
-    for point, record in ((first, done), (later, early)):
-        point.folder.mkdir(parents=True)
-        (point.folder / "point.json").write_text(json.dumps(record))
+    study, todo, first, later = _seed_and_replica(tmp_path, done, early)
     assert study._others(first, todo) == []
     assert study.status(first, done, study._others(first, todo)) == "done"
     finished = dict(early, blocks=400, cut=10)  # met its own target, 8 combined errors off
@@ -288,20 +295,12 @@ def test_replicas_that_scatter_more_than_their_errors_run_on(tmp_path):
     """study.status and next_length with the replicas' scale factor: two runs of one state
     point and start, each within its own target, 2.7 combined errors apart, have not sampled
     what their errors claim (S ≈ 2.7) and both run on; close together, both are done."""
-    study = _study()
-    plan = sys.modules["plan"]
-    todo = plan.points(plan.PLAN, tmp_path)
-    by_folder = {p.folder.name: p for p in todo}
-    first = by_folder["16384-square-0.716"]
-    later = by_folder["16384-square-replicas-0.716-seed1"]
     long = {"start": "compressed", "seed": 0, "collisions_per_disk": 1_200_000,
             "bPd2": 9.1619, "err": 0.0043, "converged": True, "drift": 0.0, "blocks": 1190,
             "cut": 9}
     short = dict(long, seed=1, collisions_per_disk=240_000, bPd2=9.1419, err=0.0061,
                  blocks=235, cut=5)
-    for point, record in ((first, long), (later, short)):
-        point.folder.mkdir(parents=True)
-        (point.folder / "point.json").write_text(json.dumps(record))
+    study, todo, first, later = _seed_and_replica(tmp_path, long, short)
     assert study._scale(first, long, study._others(first, todo)) == pytest.approx(2.68, abs=0.01)
     for point, record in ((first, long), (later, short)):
         others = study._others(point, todo)
