@@ -310,3 +310,34 @@ def test_replicas_that_scatter_more_than_their_errors_run_on(tmp_path):
     (later.folder / "point.json").write_text(json.dumps(close))
     assert study.status(first, long, study._others(first, todo)) == "done"
     assert study.status(later, close, study._others(later, todo)) == "done"
+
+
+def test_a_stop_that_reaches_a_worker_of_the_pool_between_runs_stops_its_next_run(
+        monkeypatch):
+    """Ctrl-C reaches every process of the study's group. A worker of the pool starts with
+    SIGINT and SIGTERM blocked (held back while the study starts it); one that came during
+    its start-up, or while it waits for work, is taken as a request that its next run stop
+    at its first chunk, and raises nothing (no traceback from a worker not running)."""
+    import signal
+
+    study = _study()
+    monkeypatch.setattr(Interruption, "early", None)
+    monkeypatch.setattr(Interruption, "last_signal", None)
+    handlers = {number: signal.getsignal(number) for number in study.STOPS}
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, study.STOPS)  # as a worker starts
+    try:
+        signal.raise_signal(signal.SIGINT)  # during its start-up: pending, not delivered
+        assert Interruption.early is None
+        study._between_runs()
+        assert Interruption.early == signal.SIGINT
+        assert not signal.pthread_sigmask(signal.SIG_BLOCK, ()) & study.STOPS
+        signal.raise_signal(signal.SIGTERM)  # while it waits for work
+        assert Interruption.early == signal.SIGTERM
+        with Interruption() as interruption:  # its next run stops at its first chunk
+            assert interruption.requested
+    finally:  # a signal still pending is dropped, not raised into the test session
+        for number in study.STOPS:
+            signal.signal(number, signal.SIG_IGN)
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
