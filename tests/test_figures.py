@@ -3,6 +3,8 @@ say what the figure claims. The quick suite draws the stages whose runs are smal
 canonical compiled variants (``variants.py``); ``make validate`` draws them all, as
 ``make figures QUICK=1`` does."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -251,3 +253,39 @@ def test_web_versions_are_small_and_keep_their_numbers(tmp_path):
         with Image.open(target / name) as image:
             assert image.width <= widest and (name != "fig02_two_disks.png"
                                               or image.size == (640, 480))
+
+
+def test_ctrl_c_stops_the_figures_with_one_line_and_exit_130(tmp_path, monkeypatch, capsys):
+    """A KeyboardInterrupt (Ctrl-C, or SIGTERM) while the stages are made: one line, exit
+    status 130, no traceback; the stages' workers pass the signal over (their runs stop by
+    themselves)."""
+    import sim.figures.__main__ as command
+
+    def interrupted(groups, quick, out, jobs):
+        raise KeyboardInterrupt
+        yield
+
+    monkeypatch.setattr(command, "made", interrupted)
+    assert command.main(["--quick", "--out", str(tmp_path), "--only", "single_disk"]) == 130
+    said = capsys.readouterr()
+    assert said.out == "" and said.err.count("\n") == 1 and "interrupted" in said.err
+
+
+def test_a_figure_stopped_while_it_is_written_leaves_no_file(tmp_path):
+    """``save`` writes the PNG and the PDF whole or not at all: stopped in the middle of
+    writing one, neither it nor a hidden partial file is left."""
+    import matplotlib.pyplot as plt
+
+    from sim.figures.style import save
+
+    fig, _ = plt.subplots()
+
+    def stopped(path, **options):
+        Path(path).write_bytes(b"\x89PNG half")
+        raise KeyboardInterrupt
+
+    fig.savefig = stopped
+    with pytest.raises(KeyboardInterrupt):
+        save(fig, tmp_path, "figure")
+    plt.close(fig)
+    assert list(tmp_path.iterdir()) == []

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from sim.checks.melting import loop_extrema, reference, state_point
-from sim.pipeline.interruption import Interruption
+from sim.pipeline.interruption import STOPS, Interruption
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
@@ -323,20 +323,20 @@ def test_a_stop_that_reaches_a_worker_of_the_pool_between_runs_stops_its_next_ru
     study = _study()
     monkeypatch.setattr(Interruption, "early", None)
     monkeypatch.setattr(Interruption, "last_signal", None)
-    handlers = {number: signal.getsignal(number) for number in study.STOPS}
-    held = signal.pthread_sigmask(signal.SIG_BLOCK, study.STOPS)  # as a worker starts
+    handlers = {number: signal.getsignal(number) for number in STOPS}
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, STOPS)  # as a worker starts
     try:
         signal.raise_signal(signal.SIGINT)  # during its start-up: pending, not delivered
         assert Interruption.early is None
         study._between_runs()
         assert Interruption.early == signal.SIGINT
-        assert not signal.pthread_sigmask(signal.SIG_BLOCK, ()) & study.STOPS
+        assert not signal.pthread_sigmask(signal.SIG_BLOCK, ()) & STOPS
         signal.raise_signal(signal.SIGTERM)  # while it waits for work
         assert Interruption.early == signal.SIGTERM
         with Interruption() as interruption:  # its next run stops at its first chunk
             assert interruption.requested
     finally:  # a signal still pending is dropped, not raised into the test session
-        for number in study.STOPS:
+        for number in STOPS:
             signal.signal(number, signal.SIG_IGN)
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
         for number, handler in handlers.items():

@@ -77,7 +77,7 @@ from tables import (
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
 from sim.pipeline.config import ConfigError
-from sim.pipeline.interruption import Interruption
+from sim.pipeline.interruption import Interruption, between_jobs, held_back
 from sim.pipeline.resume import resume, stored_config
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
@@ -312,32 +312,13 @@ def _run_here(todo, key):
         _report(point, advance(point, collisions_per_disk), _others(point, todo))
 
 
-#: the signals that stop the study, and each run of its workers
-STOPS = {signal.SIGINT, signal.SIGTERM}
-
-
 def _between_runs():
-    """The signals of a worker of the pool before and between its runs. Ctrl-C reaches the
-    whole process group, and the study passes its own stop on to every worker: a worker
-    takes it as a request that its next run stop at its first chunk
+    """A worker of the pool before and between its runs. Ctrl-C reaches the whole process
+    group, and the study passes its own stop on to every worker: a worker not running takes
+    SIGINT or SIGTERM as a request that its next run stop at its first chunk
     (``Interruption.take_early``), not as a KeyboardInterrupt out of its start-up or its wait
-    for work (a traceback from every worker not running). A worker starts with them blocked
-    (:func:`_submit`); one that came during its start-up is taken here. During a run, the
-    run's own handler (``Interruption``) takes them."""
-    for number in STOPS:
-        signal.signal(number, Interruption.take_early)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPS)
-
-
-def _submit(pool, point, collisions_per_disk):
-    """``pool.submit`` of a round, with SIGINT and SIGTERM held back while it may start a
-    worker (which inherits them blocked, :func:`_between_runs`); one that came meanwhile
-    reaches this process after it."""
-    held = signal.pthread_sigmask(signal.SIG_BLOCK, STOPS)
-    try:
-        return pool.submit(advance, point, collisions_per_disk)
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+    for work (a traceback from every worker not running)."""
+    between_jobs(Interruption.take_early)
 
 
 def _run_in_pool(todo, jobs, key):
@@ -362,7 +343,8 @@ def _run_in_pool(todo, jobs, key):
                 while waiting or running:
                     while waiting and len(running) < jobs:
                         point, collisions_per_disk = waiting.pop()
-                        running[_submit(pool, point, collisions_per_disk)] = point
+                        with held_back():  # a worker it starts: _between_runs
+                            running[pool.submit(advance, point, collisions_per_disk)] = point
                     finished, _ = wait(running, return_when=FIRST_COMPLETED)
                     for future in finished:
                         point = running.pop(future)

@@ -10,3 +10,5 @@ A stage is a module here with ``NAME``, ``runs(quick) -> {label: [overrides]}`` 
 STAGES = ("single_disk", "two_disks", "scattering", "gas_snapshot", "maxwell_boltzmann", "mixture",
           "mixture_cooling", "crater_grid", "crater_radius", "crater_speed", "crater_gravity",
           "rough_cooling", "crater_rough", "jamming", "stepped_potentials", "movies")
+#: the folder of the quick figures (``--quick``), inside the figures folder
+QUICK_FOLDER = "quick"

@@ -9,25 +9,49 @@ event loop another compiles (each is compiled once, :mod:`sim.engine.compilation
 its sweep's jobs, leaves its core to the others. Stages that read a common run or sweep run
 one after the other in one process. The wall-clock seconds of each stage in its process (its
 runs, its drawing, and any wait) go to ``timings.csv`` there.
+
+Ctrl-C (or SIGTERM) stops it with one line and exit status 130: the runs it reaches stop at
+their next chunk with a checkpoint (a figure that reads them is not drawn), the stages not
+begun are dropped, a worker finishes the figure it is drawing, and no figure is left
+half-written (:func:`sim.figures.style.save`).
 """
 
 import argparse
 import csv
 import os
+import signal
+import sys
 from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
 from multiprocessing import get_context
 from pathlib import Path
 
-from sim.figures import STAGES
-from sim.figures.making import batches, make_stages, stage_module
-from sim.figures.style import QUICK_FOLDER
+from sim.figures import QUICK_FOLDER, STAGES
+from sim.pipeline.interruption import between_jobs, held_back, passed_over
+from sim.storage.whole_file import whole_file
 
 
 def _cores():
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
+def _stop(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv=None):
+    """The command; its exit status (130 when stopped by SIGINT or SIGTERM)."""
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
+        return _figures(argv)
+    except KeyboardInterrupt:
+        print("figures: interrupted; the runs made so far are kept, and the same command goes "
+              "on from them", file=sys.stderr)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _figures(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small versions (CI)")
     parser.add_argument("--only", nargs="+", choices=STAGES, help="these stages only")
@@ -36,6 +60,8 @@ def main(argv=None):
                         help="stages at once (default: one more than the cores; 1: all in "
                              "this process)")
     args = parser.parse_args(argv)
+    from sim.figures.making import batches, stage_module  # matplotlib, Hydra, the engine
+
     out = Path(args.out) / (QUICK_FOLDER if args.quick else "")
     out.mkdir(parents=True, exist_ok=True)
     timings_path = out / "timings.csv"
@@ -49,29 +75,40 @@ def main(argv=None):
     for stage_name, path, seconds in made(groups, args.quick, out, args.jobs):
         print(f"{stage_name}: {path} ({seconds:.1f} s)", flush=True)
         timings[stage_name] = f"{seconds:.1f}"
-        with open(timings_path, "w", newline="") as f:
-            f.write("stage,seconds\n")
-            f.writelines(f"{key},{value}\n" for key, value in timings.items())
+        with whole_file(timings_path) as partial:
+            partial.write_text("stage,seconds\n" + "".join(
+                f"{key},{value}\n" for key, value in timings.items()))
+    return 0
 
 
 def made(groups, quick, out, jobs):
     """(stage NAME, what it wrote, seconds) of every stage of ``groups`` as it is made: in
     ``jobs`` processes, or in this one for a single job."""
+    from sim.figures.making import make_stages
+
     if jobs <= 1:
         for group in groups:
             yield from make_stages(group, quick, out)
         return
-    with ProcessPoolExecutor(jobs, mp_context=get_context("spawn")) as pool:
-        pending = {pool.submit(make_stages, group, quick, out) for group in groups}
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_EXCEPTION)
-            for future in done:
-                if future.exception() is not None:
-                    for other in pending:
-                        other.cancel()  # those not started; the running ones finish
-                    raise future.exception()
-                yield from future.result()
+    # a worker passes SIGINT and SIGTERM over: Ctrl-C reaches the whole process group, the
+    # runs of a worker's stage stop by themselves (the stage then fails), a figure being
+    # drawn is finished, and this process cancels the stages not begun
+    with ProcessPoolExecutor(jobs, mp_context=get_context("spawn"), initializer=between_jobs,
+                             initargs=(passed_over,)) as pool:
+        with held_back():  # the workers it starts
+            pending = {pool.submit(make_stages, group, quick, out) for group in groups}
+        try:
+            while pending:
+                done, pending = wait(pending, return_when=FIRST_EXCEPTION)
+                for future in done:
+                    if future.exception() is not None:
+                        raise future.exception()
+                    yield from future.result()
+        except BaseException:
+            for other in pending:
+                other.cancel()  # those not started; the running ones finish
+            raise
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

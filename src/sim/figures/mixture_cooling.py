@@ -44,7 +44,8 @@ from sim.analysis.theory import (
 )
 from sim.checks import dsmc
 from sim.checks.rows import block_means, ratio_of_means, relative_difference
-from sim.figures.style import QUICK_FOLDER, figure, save
+from sim.figures import QUICK_FOLDER
+from sim.figures.style import figure, save
 
 NAME = "fig07_mixture_cooling"
 RESTITUTION = (1.0, 0.9, 0.8)

@@ -37,7 +37,8 @@ from sim.analysis.theory import (
 from sim.checks import dsmc
 from sim.checks.rows import block_means, relative_difference
 from sim.effects.rotation import moment_of_inertia
-from sim.figures.style import QUICK_FOLDER, figure, save
+from sim.figures import QUICK_FOLDER
+from sim.figures.style import figure, save
 
 NAME = "fig12_rough_cooling"
 RESTITUTION = 0.9

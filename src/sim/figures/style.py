@@ -1,6 +1,6 @@
 """Shared look of the figures: size readable at README width, labelled axes with units; each
 saved as PNG (for the README) and PDF (vector, for papers). Quick figures (``--quick``) are
-saved in a folder named ``QUICK_FOLDER`` and say "quick" on the image."""
+saved in a folder named :data:`sim.figures.QUICK_FOLDER` and say "quick" on the image."""
 
 import matplotlib
 import numpy as np
@@ -8,6 +8,9 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
+
+from sim.figures import QUICK_FOLDER  # noqa: E402
+from sim.storage.whole_file import whole_file  # noqa: E402
 
 plt.rcParams.update({"figure.dpi": 120, "savefig.dpi": 120, "font.size": 10,
                      "axes.grid": True, "grid.alpha": 0.3, "legend.frameon": False})
@@ -32,9 +35,6 @@ def draw_disks(ax, position, radius, colors=None, values=None, cmap="viridis", c
     return disks
 
 
-#: the folder of the quick figures, inside the figures folder
-QUICK_FOLDER = "quick"
-
 
 def save(fig, out_dir, name):
     """``name``.png and ``name``.pdf in ``out_dir``; returns the PNG's path."""
@@ -42,7 +42,8 @@ def save(fig, out_dir, name):
         fig.text(0.995, 0.005, "quick (small runs)", ha="right", va="bottom", fontsize=8,
                  color="C3")
     path = out_dir / f"{name}.png"
-    fig.savefig(path)
-    fig.savefig(path.with_suffix(".pdf"))
+    for target in (path, path.with_suffix(".pdf")):
+        with whole_file(target) as partial:  # whole or not at all, stopped midway
+            fig.savefig(partial)
     plt.close(fig)
     return path

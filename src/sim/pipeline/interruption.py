@@ -1,10 +1,15 @@
 """SIGINT and SIGTERM (and, in a job on a cluster, the scheduler's warning of its time limit)
-as a request to stop a run between compiled chunks."""
+as a request to stop a run between compiled chunks; and what a pool's worker process does
+with them before and between its runs (:func:`held_back`, :func:`between_jobs`)."""
 
 import signal
 import threading
+from contextlib import contextmanager
 
 from sim.pipeline import sweep_stop
+
+#: the signals that ask a run, a study or a pool of workers to stop
+STOPS = frozenset({signal.SIGINT, signal.SIGTERM})
 
 
 def _run_pending_handlers():
@@ -89,3 +94,31 @@ class Interruption:
         for number, previous in self._previous.items():
             signal.signal(number, previous)
         return False
+
+
+@contextmanager
+def held_back():
+    """SIGINT and SIGTERM blocked in this thread for the block and delivered after it. A
+    worker process started in the block (``ProcessPoolExecutor.submit`` starts them) begins
+    with them blocked, so that Ctrl-C, which reaches the whole process group, cannot raise
+    a KeyboardInterrupt out of its start-up; its initializer says what it does with them
+    (:func:`between_jobs`)."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, STOPS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
+def passed_over(signum, frame):
+    """A handler that does nothing: the signal is passed over. Unlike ``SIG_IGN``, a process
+    started from this one (a run) does not inherit it."""
+
+
+def between_jobs(handler):
+    """In a worker started under :func:`held_back`: ``handler`` for SIGINT and SIGTERM, then
+    the two unblocked (one that came during the start-up is handled now). During a run, the
+    run's own :class:`Interruption` takes them."""
+    for number in STOPS:
+        signal.signal(number, handler)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPS)
