@@ -35,7 +35,6 @@ def draw_disks(ax, position, radius, colors=None, values=None, cmap="viridis", c
     return disks
 
 
-
 def save(fig, out_dir, name):
     """``name``.png and ``name``.pdf in ``out_dir``; returns the PNG's path."""
     if out_dir.name == QUICK_FOLDER:
