@@ -341,3 +341,23 @@ def test_a_stop_that_reaches_a_worker_of_the_pool_between_runs_stops_its_next_ru
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
         for number, handler in handlers.items():
             signal.signal(number, handler)
+
+
+def test_a_clone_keeps_the_coexistence_snapshot_it_cannot_draw(tmp_path):
+    """With no run file of N = 128² here, the ψ₆ figure of the ledger's folder is kept as it
+    is (its snapshot needs a run file; its g₆ traces could not have changed), not redrawn
+    with an empty panel; with no such figure, one is drawn."""
+    _study()
+    figures = sys.modules["figures"]
+    records = [{"n": figures.TRACED, "phi": 0.708, "start": "compressed", "seed": 0,
+                "trace": {"r": [1.0, 2.0], "g6": [0.9, 0.5]}}]
+    kept = tmp_path / "ledger" / "melting_psi6.png"
+    kept.parent.mkdir()
+    kept.write_bytes(b"the committed figure")
+    results = tmp_path / "results"
+    results.mkdir()
+    figures.draw_bond_order(records, [], tmp_path / "out", results, kept=kept)
+    assert (results / "melting_psi6.png").read_bytes() == b"the committed figure"
+    kept.unlink()
+    figures.draw_bond_order(records, [], tmp_path / "out", results, kept=kept)
+    assert (results / "melting_psi6.png").read_bytes()[:4] == b"\x89PNG"

@@ -4,6 +4,7 @@ started both ways; and the traces of the runs of N = 128² that the records keep
 Each is written in full (PNG and PDF) under the study's output folder and as a web version
 into the results folder."""
 
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -155,13 +156,21 @@ def draw_starts(records, out, results):
     publish(fig, "melting_starts", out, results)
 
 
-def draw_bond_order(records, todo, out, results):
+def draw_bond_order(records, todo, out, results, kept=None):
     """The last snapshot of the N = 128² run nearest φ = 0.708 whose run file is here at the
     length of its record, every disk coloured by the phase of its ψ₆, and |g₆(r)| of the
-    last snapshot of every N = 128² run (their traces)."""
+    last snapshot of every N = 128² run (their traces). With no run file of N = 128² here
+    (a clone, which goes on from the ledger), no N = 128² run has been made since the
+    ledger's figure ``kept`` was drawn: that figure is kept, not redrawn without its
+    snapshot."""
     large = [r for r in records if r["n"] == TRACED and "trace" in r]
     here = [p for p in todo if p.group.n == TRACED and (p.folder / "run.h5").exists()]
     if not large:
+        return
+    target = results / "melting_psi6.png"
+    if not here and kept is not None and kept.exists():
+        if kept.resolve() != target.resolve():
+            shutil.copyfile(kept, target)
         return
     fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, 5.6), constrained_layout=True,
                                       gridspec_kw={"width_ratios": (1.1, 1.0)})

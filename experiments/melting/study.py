@@ -403,9 +403,10 @@ def simulate(todo, out, jobs, cluster=None, partition=None, shortest_first=False
         _run_in_pool(todo, jobs, urgency(shortest_first))
 
 
-def summarise(todo, out, results):
+def summarise(todo, out, results, ledger=None):
     """The tables, the figures, melting.md and melting.json of the points of ``todo`` that
-    have a record, each with its :func:`status`."""
+    have a record, each with its :func:`status`; the coexistence snapshot of the ``ledger``'s
+    folder where no run file of N = 128² is here (:func:`figures.draw_bond_order`)."""
     records = [dict(record, status=status(p, record, _others(p, todo)), replicas=p.replicas)
                for p in todo if (record := _record(p)) is not None]
     measured = [r for r in records if "bPd2" in r]
@@ -414,7 +415,8 @@ def summarise(todo, out, results):
     found = extrema(measured)
     write_markdown(records, found, results)
     draw_equation_of_state(measured, out, results)
-    draw_bond_order(measured, todo, out, results)
+    draw_bond_order(measured, todo, out, results,
+                    kept=None if ledger is None else Path(ledger).parent / "melting_psi6.png")
     draw_starts(measured, out, results)
     hours, _ = processor_hours(records)
     summary = {"points": records, "extrema": found,
@@ -458,7 +460,8 @@ def main(argv=None):
     # the points of the whole plan, so that a point's replicas are counted in every case
     todo = [p for p in points(plan, args.out)
             if not args.groups or p.group.name in args.groups]
-    adopt(todo, args.ledger or (None if args.quick else LEDGER))
+    ledger = args.ledger or (None if args.quick else LEDGER)
+    adopt(todo, ledger)
     try:
         if not args.report:
             simulate(todo, args.out, args.jobs, args.cluster, args.partition,
@@ -466,7 +469,7 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("melting: interrupted; run it again to go on where it stopped", file=sys.stderr)
         return 130
-    summarise(todo, args.out, args.results)
+    summarise(todo, args.out, args.results, ledger)
     return 0
 
 
