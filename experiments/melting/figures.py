@@ -167,10 +167,9 @@ def draw_bond_order(records, todo, out, results, kept=None):
     here = [p for p in todo if p.group.n == TRACED and (p.folder / "run.h5").exists()]
     if not large:
         return
-    target = results / "melting_psi6.png"
     if not here and kept is not None and kept.exists():
-        if kept.resolve() != target.resolve():
-            shutil.copyfile(kept, target)
+        if kept.resolve() != (results / kept.name).resolve():
+            shutil.copyfile(kept, results / kept.name)
         return
     fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, 5.6), constrained_layout=True,
                                       gridspec_kw={"width_ratios": (1.1, 1.0)})

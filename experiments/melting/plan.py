@@ -66,11 +66,9 @@ class Group:
 #: times below the published one), or where one run would need more hours than a job holds
 #: (N = 128² at 0.716 from the compressed start, about six on one core at 1.6·10⁶ collisions
 #: per second): replicas, run side by side, whose weighted mean is the state point's
-#: pressure (:func:`tables.estimates`) once they agree (``AGREEMENT``). Its four replicas,
-#: 0.8–2.4·10⁵ collisions per disk long, two of them done by their own errors, scattered
-#: more than twice as much as those errors said (the scale factor in melting.md): a short
-#: run's blocking misses the slowest fluctuations, and replicas save no processor hours
-#: here, only hours of waiting
+#: pressure (:func:`tables.estimates`) once they agree (``AGREEMENT``). Each must still be
+#: long enough for its own blocking to see the slowest fluctuations (their scale factor in
+#: melting.md): replicas save hours of waiting, not processor hours
 PLAN = (
     Group("72-square", 72, "1:1", (0.650, 0.660, 0.670, 0.680, 0.686, 0.690, 0.694, 0.698,
                                    0.702, 0.706, 0.710, 0.720),

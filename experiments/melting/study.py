@@ -76,6 +76,7 @@ from tables import (
 
 from sim.analysis.datasets import global_bond_order, open_run
 from sim.analysis.equation_of_state import run_pressure
+from sim.pipeline.command import interrupt
 from sim.pipeline.config import ConfigError
 from sim.pipeline.interruption import Interruption, between_jobs, held_back
 from sim.pipeline.resume import resume, stored_config
@@ -330,11 +331,8 @@ def _run_in_pool(todo, jobs, key):
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from multiprocessing import active_children, get_context
 
-    def stop(signum, frame):
-        raise KeyboardInterrupt
-
     waiting = sorted(_pending(todo), key=key)
-    previous = signal.signal(signal.SIGTERM, stop)
+    previous = signal.signal(signal.SIGTERM, interrupt)
     try:
         with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"),
                                  initializer=_between_runs) as pool:

@@ -10,22 +10,21 @@ its sweep's jobs, leaves its core to the others. Stages that read a common run o
 one after the other in one process. The wall-clock seconds of each stage in its process (its
 runs, its drawing, and any wait) go to ``timings.csv`` there.
 
-Ctrl-C (or SIGTERM) stops it with one line and exit status 130: the runs it reaches stop at
+Ctrl-C (or SIGTERM) stops it with one line and exit status 130 (143): the runs it reaches stop at
 their next chunk with a checkpoint (a figure that reads them is not drawn), the stages not
 begun are dropped, a worker finishes the figure it is drawing, and no figure is left
 half-written (:func:`sim.figures.style.save`).
 """
 
-import argparse
 import csv
 import os
-import signal
 import sys
 from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
 from multiprocessing import get_context
 from pathlib import Path
 
 from sim.figures import QUICK_FOLDER, STAGES
+from sim.pipeline.command import Parser, run_command
 from sim.pipeline.interruption import between_jobs, held_back, passed_over
 from sim.storage.whole_file import whole_file
 
@@ -34,25 +33,16 @@ def _cores():
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
-def _stop(signum, frame):
-    raise KeyboardInterrupt
-
-
 def main(argv=None):
-    """The command; its exit status (130 when stopped by SIGINT or SIGTERM)."""
-    previous = signal.signal(signal.SIGTERM, _stop)
-    try:
-        return _figures(argv)
-    except KeyboardInterrupt:
-        print("figures: interrupted; the runs made so far are kept, and the same command goes "
-              "on from them", file=sys.stderr)
-        return 130
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    """The command; its exit status (:func:`sim.pipeline.command.run_command`: 2 bad input,
+    130 or 143 stopped by SIGINT or SIGTERM)."""
+    return run_command("figures", lambda: _figures(argv),
+                       unwritten="the runs made so far are kept, and the same command goes "
+                                 "on from them")
 
 
 def _figures(argv):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = Parser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small versions (CI)")
     parser.add_argument("--only", nargs="+", choices=STAGES, help="these stages only")
     parser.add_argument("--out", default="outputs/figures", help="output folder")
@@ -78,7 +68,6 @@ def _figures(argv):
         with whole_file(timings_path) as partial:
             partial.write_text("stage,seconds\n" + "".join(
                 f"{key},{value}\n" for key, value in timings.items()))
-    return 0
 
 
 def made(groups, quick, out, jobs):
