@@ -63,7 +63,11 @@ class Group:
 #: Runs again with other seeds, where one run lies more than 3 combined errors from the
 #: published value (N = 72 in its lattice box at φ = 0.696; N = 224 at 0.720, whose
 #: compressed fluid froze into one crystal that the run never left, its blocking error ten
-#: times below the published one), or where one run would need more hours than a job holds
+#: times below the published one; N = 870 in its square box past the loop, φ = 0.714–0.718,
+#: whose compressed fluid can freeze for a while into a strained crystal: at 0.718, seed 0,
+#: βP d² ≈ 9.38 from 1.3·10⁵ to 10⁶ collisions per disk, fluid at ≈ 9.0 before and after,
+#: and at 0.716 a run called done inside such a crystal, far above the published pressure),
+#: or where one run would need more hours than a job holds
 #: (N = 128² at 0.716 from the compressed start, about six on one core at 1.6·10⁶ collisions
 #: per second): replicas, run side by side, whose weighted mean is the state point's
 #: pressure (:func:`tables.estimates`) once they agree (``AGREEMENT``). Each must still be
@@ -86,6 +90,8 @@ PLAN = (
     Group("870-square", 870, "1:1", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706, 0.710,
                                      0.712, 0.714, 0.716, 0.718),
           "compressed", 200, 100_000, 3_000_000, 0.003),
+    Group("870-square-replicas", 870, "1:1", (0.714, 0.716, 0.718),
+          "compressed", 200, 100_000, 3_000_000, 0.003, seeds=(1,)),
     Group("870-lattice", 870, "29:30√3/2", (0.670, 0.680, 0.690, 0.694, 0.698, 0.702, 0.706,
                                             0.710, 0.712),
           "compressed", 200, 100_000, 3_000_000, 0.003),
