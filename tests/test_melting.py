@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from sim.checks.melting import loop_extrema, reference, state_point
-from sim.pipeline.interruption import STOPS, Interruption
+from sim.pipeline.interruption import STOPS, Interruption, between_jobs
 from sim.pipeline.run_cache import compose_config
 from sim.pipeline.runner import run
 
@@ -320,7 +320,6 @@ def test_a_stop_that_reaches_a_worker_of_the_pool_between_runs_stops_its_next_ru
     at its first chunk, and raises nothing (no traceback from a worker not running)."""
     import signal
 
-    study = _study()
     monkeypatch.setattr(Interruption, "early", None)
     monkeypatch.setattr(Interruption, "last_signal", None)
     handlers = {number: signal.getsignal(number) for number in STOPS}
@@ -328,7 +327,7 @@ def test_a_stop_that_reaches_a_worker_of_the_pool_between_runs_stops_its_next_ru
     try:
         signal.raise_signal(signal.SIGINT)  # during its start-up: pending, not delivered
         assert Interruption.early is None
-        study._between_runs()
+        between_jobs(Interruption.take_early)  # the pool's initializer
         assert Interruption.early == signal.SIGINT
         assert not signal.pthread_sigmask(signal.SIG_BLOCK, ()) & STOPS
         signal.raise_signal(signal.SIGTERM)  # while it waits for work
@@ -356,8 +355,8 @@ def test_a_clone_keeps_the_coexistence_snapshot_it_cannot_draw(tmp_path):
     kept.write_bytes(b"the committed figure")
     results = tmp_path / "results"
     results.mkdir()
-    figures.draw_bond_order(records, [], tmp_path / "out", results, kept=kept)
+    figures.draw_bond_order(records, [], tmp_path / "out", results, kept_in=kept.parent)
     assert (results / "melting_psi6.png").read_bytes() == b"the committed figure"
     kept.unlink()
-    figures.draw_bond_order(records, [], tmp_path / "out", results, kept=kept)
+    figures.draw_bond_order(records, [], tmp_path / "out", results, kept_in=kept.parent)
     assert (results / "melting_psi6.png").read_bytes()[:4] == b"\x89PNG"

@@ -156,17 +156,22 @@ def draw_starts(records, out, results):
     publish(fig, "melting_starts", out, results)
 
 
-def draw_bond_order(records, todo, out, results, kept=None):
+#: the name of the coexistence snapshot's figure (:func:`draw_bond_order`)
+BOND_ORDER = "melting_psi6"
+
+
+def draw_bond_order(records, todo, out, results, kept_in=None):
     """The last snapshot of the N = 128² run nearest φ = 0.708 whose run file is here at the
     length of its record, every disk coloured by the phase of its ψ₆, and |g₆(r)| of the
     last snapshot of every N = 128² run (their traces). With no run file of N = 128² here
     (a clone, which goes on from the ledger), no N = 128² run has been made since the
-    ledger's figure ``kept`` was drawn: that figure is kept, not redrawn without its
-    snapshot."""
+    ledger's figure in the folder ``kept_in`` was drawn: that figure is kept, not redrawn
+    without its snapshot."""
     large = [r for r in records if r["n"] == TRACED and "trace" in r]
     here = [p for p in todo if p.group.n == TRACED and (p.folder / "run.h5").exists()]
     if not large:
         return
+    kept = None if kept_in is None else kept_in / f"{BOND_ORDER}.png"
     if not here and kept is not None and kept.exists():
         if kept.resolve() != (results / kept.name).resolve():
             shutil.copyfile(kept, results / kept.name)
@@ -218,4 +223,4 @@ def draw_bond_order(records, todo, out, results, kept=None):
         left.text(0.5, 0.5, "no run file of N = 128² here:\nthe snapshot is drawn where the "
                   "study has run", ha="center", va="center", transform=left.transAxes)
         left.set_axis_off()
-    publish(fig, "melting_psi6", out, results)
+    publish(fig, BOND_ORDER, out, results)

@@ -313,15 +313,6 @@ def _run_here(todo, key):
         _report(point, advance(point, collisions_per_disk), _others(point, todo))
 
 
-def _between_runs():
-    """A worker of the pool before and between its runs. Ctrl-C reaches the whole process
-    group, and the study passes its own stop on to every worker: a worker not running takes
-    SIGINT or SIGTERM as a request that its next run stop at its first chunk
-    (``Interruption.take_early``), not as a KeyboardInterrupt out of its start-up or its wait
-    for work (a traceback from every worker not running)."""
-    between_jobs(Interruption.take_early)
-
-
 def _run_in_pool(todo, jobs, key):
     """Every point's rounds in ``jobs`` worker processes (spawned: the engine compiles in each,
     from numba's cache), in the order of ``key`` (:func:`urgency`); a point whose round ends
@@ -333,15 +324,19 @@ def _run_in_pool(todo, jobs, key):
 
     waiting = sorted(_pending(todo), key=key)
     previous = signal.signal(signal.SIGTERM, interrupt)
+    # Ctrl-C reaches the whole process group: a worker not running takes SIGINT or SIGTERM as
+    # a request that its next run stop at its first chunk, not as a KeyboardInterrupt out of
+    # its start-up or its wait for work (a traceback from every worker not running)
     try:
         with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"),
-                                 initializer=_between_runs) as pool:
+                                 initializer=between_jobs,
+                                 initargs=(Interruption.take_early,)) as pool:
             running = {}
             try:
                 while waiting or running:
                     while waiting and len(running) < jobs:
                         point, collisions_per_disk = waiting.pop()
-                        with held_back():  # a worker it starts: _between_runs
+                        with held_back():  # a worker it starts: between_jobs
                             running[pool.submit(advance, point, collisions_per_disk)] = point
                     finished, _ = wait(running, return_when=FIRST_COMPLETED)
                     for future in finished:
@@ -414,7 +409,7 @@ def summarise(todo, out, results, ledger=None):
     write_markdown(records, found, results)
     draw_equation_of_state(measured, out, results)
     draw_bond_order(measured, todo, out, results,
-                    kept=None if ledger is None else Path(ledger).parent / "melting_psi6.png")
+                    kept_in=None if ledger is None else Path(ledger).parent)
     draw_starts(measured, out, results)
     hours, _ = processor_hours(records)
     summary = {"points": records, "extrema": found,
